@@ -1,0 +1,113 @@
+//! The interface every backend implements (CPU here; OpenGL in `kantele-gl`; CUDA later): load a
+//! [`Scene`] once, render frames of it, read the pictures back.
+//!
+//! Loading (uploading meshes and textures, building mip levels) is outside a frame; a frame is
+//! clear + every draw + waiting for the image to be complete, as the timing rules require.
+
+use std::sync::Arc;
+
+use glam::{Mat4, Vec3};
+
+use crate::error::RenderError;
+use crate::scene::Scene;
+use crate::stats::FrameStats;
+
+/// What a frame writes into the colour buffer.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Pass {
+    /// The shaded picture (linear RGBA).
+    #[default]
+    Color,
+    /// World-space unit normals (after two-sided flipping) in RGB, alpha 1; background is the
+    /// clear value 0.
+    Normals,
+    /// Exact integer ids stored in float channels: R = draw's `node_index + 1`, G = triangle
+    /// index within its mesh + 1, B = draw index + 1; background 0.
+    Ids,
+}
+
+/// Camera, light and size of one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameView {
+    /// Target width in pixels.
+    pub width: u32,
+    /// Target height in pixels.
+    pub height: u32,
+    /// World → eye.
+    pub view: Mat4,
+    /// Eye → clip (OpenGL conventions).
+    pub projection: Mat4,
+    /// Unit vector towards the light, world space.
+    pub to_light: Vec3,
+    /// Light colour × intensity.
+    pub light_color: Vec3,
+    /// What to render.
+    pub pass: Pass,
+}
+
+impl FrameView {
+    /// The view the scene itself asks for: its camera, light and resolution.
+    pub fn of_scene(scene: &Scene) -> Self {
+        let (width, height) = scene.resolution;
+        Self::with_camera(scene, &scene.camera, width, height)
+    }
+
+    /// The scene seen through `camera` at `width × height`.
+    pub fn with_camera(
+        scene: &Scene,
+        camera: &crate::scene::Camera,
+        width: u32,
+        height: u32,
+    ) -> Self {
+        let aspect = width as f32 / height.max(1) as f32;
+        let (to_light, light_color) = scene.light.resolve(&camera.view);
+        Self {
+            width,
+            height,
+            view: camera.view,
+            projection: camera.projection(aspect),
+            to_light,
+            light_color,
+            pass: Pass::Color,
+        }
+    }
+}
+
+/// A finished frame read back from a backend.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FrameImage {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// Row-major linear RGBA, row 0 = top row.
+    pub color: Vec<[f32; 4]>,
+    /// Row-major window depth in [0, 1] (1 = background), row 0 = top row.
+    pub depth: Vec<f32>,
+}
+
+impl FrameImage {
+    /// The colour buffer as 8-bit RGBA, RGB encoded to sRGB when `srgb` is set.
+    pub fn to_rgba8(&self, srgb: bool) -> Vec<u8> {
+        self.color
+            .iter()
+            .flat_map(|c| crate::color::encode_rgba8(*c, srgb))
+            .collect()
+    }
+}
+
+/// A renderer of [`Scene`]s.
+pub trait Backend {
+    /// Short name: `cpu`, `gl`, `cuda`.
+    fn name(&self) -> &str;
+    /// What actually renders: e.g. `kantele cpu (bisector, 2 threads)` or the GL_RENDERER string.
+    fn renderer(&self) -> String;
+    /// Threads the backend renders with (1 for a GPU driver).
+    fn threads(&self) -> usize;
+    /// Takes the scene and uploads what it needs. Not part of a frame.
+    fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError>;
+    /// Renders one complete frame of the loaded scene and waits until it is finished.
+    fn render(&mut self, view: &FrameView) -> Result<FrameStats, RenderError>;
+    /// Reads back the last frame.
+    fn read_frame(&mut self) -> Result<FrameImage, RenderError>;
+}

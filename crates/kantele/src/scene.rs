@@ -1,0 +1,337 @@
+//! Plain scene data shared by every backend: meshes, materials, textures, draws, camera and
+//! light. Loaders (`kantele-io`) fill it; backends draw it by the rules of the reference scenes
+//! (see the crate docs): draws in order, Lambert or unlit shading, alpha modes.
+
+use std::sync::Arc;
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+
+use crate::camera;
+use crate::error::RenderError;
+use crate::shade::texture::{Sampler, Texture};
+
+/// An indexed triangle list with the standard vertex attributes.
+#[derive(Clone, Debug, Default)]
+pub struct Mesh {
+    /// Name for reports (glTF mesh name, OBJ object name); may be empty.
+    pub name: String,
+    /// Object-space positions.
+    pub positions: Vec<Vec3>,
+    /// Object-space normals, one per position; `None` means flat shading from face normals.
+    pub normals: Option<Vec<Vec3>>,
+    /// Texture coordinates (`TEXCOORD_0`), one per position; (0, 0) is the image's top-left.
+    pub texcoords: Option<Vec<Vec2>>,
+    /// Linear vertex colours (`COLOR_0`), RGBA, one per position.
+    pub colors: Option<Vec<Vec4>>,
+    /// Triangle list: three indices per triangle.
+    pub indices: Vec<u32>,
+    /// Index into [`Scene::materials`].
+    pub material: usize,
+}
+
+impl Mesh {
+    /// Number of triangles.
+    pub fn triangle_count(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    /// Object-space bounding box `(min, max)` of the referenced positions, ignoring non-finite
+    /// ones; `None` when there are none.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        let mut it = self.positions.iter().filter(|p| p.is_finite());
+        let first = *it.next()?;
+        Some(it.fold((first, first), |(lo, hi), p| (lo.min(*p), hi.max(*p))))
+    }
+}
+
+/// How a material treats alpha (glTF `alphaMode`).
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub enum AlphaMode {
+    /// Alpha is ignored (taken as 1).
+    #[default]
+    Opaque,
+    /// Fragments with alpha below the cutoff are discarded; the rest are opaque.
+    Mask {
+        /// `alphaCutoff` (glTF default 0.5).
+        cutoff: f32,
+    },
+    /// `dst = src.rgb × src.a + dst × (1 − src.a)`, depth tested but not written.
+    Blend,
+}
+
+/// A texture reference with the sampler it is read through.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureBinding {
+    /// Index into [`Scene::textures`].
+    pub texture: usize,
+    /// How it is sampled.
+    pub sampler: Sampler,
+}
+
+/// A material with the shading rules of the reference scenes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    /// Name for reports; may be empty.
+    pub name: String,
+    /// Linear RGBA factor (`baseColorFactor`).
+    pub base_color_factor: Vec4,
+    /// sRGB base colour texture, multiplied in after decoding.
+    pub base_color_texture: Option<TextureBinding>,
+    /// Back faces are drawn (and lit from their side) instead of culled.
+    pub double_sided: bool,
+    /// Alpha handling.
+    pub alpha_mode: AlphaMode,
+    /// `KHR_materials_unlit`: colour = base colour.
+    pub unlit: bool,
+}
+
+impl Default for Material {
+    fn default() -> Self {
+        Self {
+            name: String::new(),
+            base_color_factor: Vec4::ONE,
+            base_color_texture: None,
+            double_sided: false,
+            alpha_mode: AlphaMode::Opaque,
+            unlit: false,
+        }
+    }
+}
+
+/// One draw: a mesh placed in the world by a node.
+#[derive(Clone, Debug)]
+pub struct Draw {
+    /// Index into [`Scene::meshes`].
+    pub mesh: usize,
+    /// Object → world transform.
+    pub model: Mat4,
+    /// The node's name (for id maps); may be empty.
+    pub node_name: String,
+    /// The node's index in the source file (instance id − 1 in id buffers).
+    pub node_index: usize,
+}
+
+/// A perspective camera: placement plus glTF-style projection parameters.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Camera {
+    /// World → eye transform (inverse of the camera node's world matrix).
+    pub view: Mat4,
+    /// Vertical field of view in radians.
+    pub yfov: f32,
+    /// Width / height; `None` means the render target's aspect.
+    pub aspect_ratio: Option<f32>,
+    /// Near plane distance (> 0).
+    pub znear: f32,
+    /// Far plane distance; `None` is an infinite projection.
+    pub zfar: Option<f32>,
+}
+
+impl Camera {
+    /// The projection matrix for a target of the given aspect ratio (used when the camera has
+    /// none of its own).
+    pub fn projection(&self, target_aspect: f32) -> Mat4 {
+        let aspect = self.aspect_ratio.unwrap_or(target_aspect);
+        match self.zfar {
+            Some(far) => camera::perspective(self.yfov, aspect, self.znear, far),
+            None => camera::perspective_infinite(self.yfov, aspect, self.znear),
+        }
+    }
+
+    /// Eye → world transform.
+    pub fn world_from_eye(&self) -> Mat4 {
+        self.view.inverse()
+    }
+
+    /// A camera looking at the bounding sphere `(center, radius)` from direction `from_dir`
+    /// (towards the eye), framing it completely for the given aspect ratio.
+    pub fn framing(center: Vec3, radius: f32, from_dir: Vec3, aspect: f32) -> Self {
+        let yfov = 45f32.to_radians();
+        let radius = if radius.is_finite() && radius > 0.0 {
+            radius
+        } else {
+            1.0
+        };
+        let half = 0.5 * yfov.min(2.0 * (aspect.max(1e-3) * (0.5 * yfov).tan()).atan());
+        let distance = radius / half.sin();
+        let dir = from_dir.try_normalize().unwrap_or(Vec3::Z);
+        let eye = center + dir * distance;
+        let up = if dir.cross(Vec3::Y).length_squared() < 1e-6 {
+            Vec3::Z
+        } else {
+            Vec3::Y
+        };
+        Self {
+            view: camera::look_at(eye, center, up),
+            yfov,
+            aspect_ratio: None,
+            znear: (distance - radius).max(distance * 1e-3) * 0.5,
+            zfar: Some(distance + radius * 2.0),
+        }
+    }
+}
+
+/// The scene's light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Light {
+    /// A directional light shining along the camera's view direction (`L` = camera +Z), colour 1.
+    Headlight,
+    /// A directional light.
+    Directional {
+        /// Unit vector towards the light, in world space (the light node's world +Z).
+        to_light: Vec3,
+        /// Colour × intensity.
+        color: Vec3,
+    },
+}
+
+impl Light {
+    /// `(L, colour)` in world space for a camera with the given view matrix.
+    pub fn resolve(&self, view: &Mat4) -> (Vec3, Vec3) {
+        match *self {
+            Light::Headlight => {
+                let to_light = view
+                    .inverse()
+                    .transform_vector3(Vec3::Z)
+                    .normalize_or_zero();
+                (to_light, Vec3::ONE)
+            }
+            Light::Directional { to_light, color } => (to_light.normalize_or_zero(), color),
+        }
+    }
+}
+
+/// Everything needed to draw a picture by the reference-scene rules.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// Meshes (glTF primitives), referenced by draws.
+    pub meshes: Vec<Mesh>,
+    /// Materials, referenced by meshes.
+    pub materials: Vec<Material>,
+    /// Decoded textures with mip chains, referenced by materials.
+    pub textures: Vec<Arc<Texture>>,
+    /// Draws in draw order.
+    pub draws: Vec<Draw>,
+    /// The scene's camera (a loader supplies a framing one when the file has none).
+    pub camera: Camera,
+    /// The light.
+    pub light: Light,
+    /// Ambient term of the Lambert rule.
+    pub ambient: f32,
+    /// Linear clear colour.
+    pub clear_color: Vec4,
+    /// Image size `(width, height)` the scene asks for.
+    pub resolution: (u32, u32),
+}
+
+impl Default for Scene {
+    fn default() -> Self {
+        Self {
+            meshes: Vec::new(),
+            materials: Vec::new(),
+            textures: Vec::new(),
+            draws: Vec::new(),
+            camera: Camera::framing(Vec3::ZERO, 1.0, Vec3::Z, 4.0 / 3.0),
+            light: Light::Headlight,
+            ambient: 0.1,
+            clear_color: Vec4::new(0.0, 0.0, 0.0, 1.0),
+            resolution: (800, 600),
+        }
+    }
+}
+
+impl Scene {
+    /// Total triangles drawn per frame (a mesh drawn twice counts twice).
+    pub fn triangle_count(&self) -> usize {
+        self.draws
+            .iter()
+            .map(|d| self.meshes.get(d.mesh).map_or(0, Mesh::triangle_count))
+            .sum()
+    }
+
+    /// World-space bounding sphere `(center, radius)` of everything drawn (from the boxes).
+    pub fn bounding_sphere(&self) -> Option<(Vec3, f32)> {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for draw in &self.draws {
+            let Some((a, b)) = self.meshes.get(draw.mesh).and_then(Mesh::bounds) else {
+                continue;
+            };
+            for i in 0..8 {
+                let corner = Vec3::new(
+                    if i & 1 == 0 { a.x } else { b.x },
+                    if i & 2 == 0 { a.y } else { b.y },
+                    if i & 4 == 0 { a.z } else { b.z },
+                );
+                let p = draw.model.transform_point3(corner);
+                if p.is_finite() {
+                    lo = lo.min(p);
+                    hi = hi.max(p);
+                }
+            }
+        }
+        if !(lo.x <= hi.x) {
+            return None;
+        }
+        let center = (lo + hi) * 0.5;
+        Some((center, (hi - lo).length() * 0.5))
+    }
+
+    /// Checks every cross reference (draw → mesh → material → texture) and every index.
+    pub fn validate(&self) -> Result<(), RenderError> {
+        for (i, draw) in self.draws.iter().enumerate() {
+            if draw.mesh >= self.meshes.len() {
+                return Err(RenderError::InvalidScene(format!(
+                    "draw {i} refers to mesh {} of {}",
+                    draw.mesh,
+                    self.meshes.len()
+                )));
+            }
+        }
+        for (i, mesh) in self.meshes.iter().enumerate() {
+            let n = mesh.positions.len();
+            if mesh.material >= self.materials.len() {
+                return Err(RenderError::InvalidScene(format!(
+                    "mesh {i} refers to material {} of {}",
+                    mesh.material,
+                    self.materials.len()
+                )));
+            }
+            let attribute_ok = |len: Option<usize>| len.is_none_or(|l| l == n);
+            if !attribute_ok(mesh.normals.as_ref().map(Vec::len))
+                || !attribute_ok(mesh.texcoords.as_ref().map(Vec::len))
+                || !attribute_ok(mesh.colors.as_ref().map(Vec::len))
+            {
+                return Err(RenderError::InvalidScene(format!(
+                    "mesh {i}: attribute count differs from its {n} positions"
+                )));
+            }
+            if mesh.indices.len() % 3 != 0 {
+                return Err(RenderError::IncompleteTriangle(mesh.indices.len()));
+            }
+            if let Some((position, &index)) = mesh
+                .indices
+                .iter()
+                .enumerate()
+                .find(|(_, &ix)| ix as usize >= n)
+            {
+                return Err(RenderError::IndexOutOfRange {
+                    index,
+                    position,
+                    vertex_count: n,
+                });
+            }
+        }
+        for (i, material) in self.materials.iter().enumerate() {
+            if let Some(binding) = material.base_color_texture {
+                if binding.texture >= self.textures.len() {
+                    return Err(RenderError::InvalidScene(format!(
+                        "material {i} refers to texture {} of {}",
+                        binding.texture,
+                        self.textures.len()
+                    )));
+                }
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,2 @@
+//! Shading resources.
+pub mod texture;
