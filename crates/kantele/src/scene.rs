@@ -269,7 +269,7 @@ impl Scene {
                 }
             }
         }
-        if !(lo.x <= hi.x) {
+        if lo.x > hi.x {
             return None;
         }
         let center = (lo + hi) * 0.5;

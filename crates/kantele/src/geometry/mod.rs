@@ -1,0 +1,5 @@
+//! Primitive stage: trivial reject, clipping in homogeneous clip space, and the viewport
+//! transform. Takes clip-space vertices with varyings from the vertex stage and hands polygons
+//! that are safe to snap (inside the near plane and the guard band) to setup.
+
+pub mod clip;

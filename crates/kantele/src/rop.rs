@@ -1,0 +1,270 @@
+//! Output merger: depth test, blending, and the tiled framebuffer they write to.
+//!
+//! Colour is kept as linear `f32` RGBA (so blending happens in linear space and nothing is lost
+//! before the final encode); it is converted to 8-bit — sRGB-encoded or not — when read back.
+//! Storage is tile-major: each 64 × 64 tile owns its colour and depth, so tiles can be
+//! rasterized in parallel without sharing memory.
+
+use glam::Vec4;
+
+use crate::fixed::{TILE_LOG2, TILE_PIXELS, TILE_SIZE};
+use crate::raster::bin::TileGrid;
+
+/// Depth comparison: a fragment passes when `fragment_depth OP stored_depth` holds.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum DepthFunc {
+    /// Never passes.
+    Never,
+    /// Passes when closer.
+    #[default]
+    Less,
+    /// Passes when equal.
+    Equal,
+    /// Passes when closer or equal.
+    LessEqual,
+    /// Passes when farther.
+    Greater,
+    /// Passes when different.
+    NotEqual,
+    /// Passes when farther or equal.
+    GreaterEqual,
+    /// Always passes.
+    Always,
+}
+
+impl DepthFunc {
+    /// Whether a fragment at depth `fragment` passes against `stored`.
+    #[inline]
+    pub fn passes(self, fragment: f32, stored: f32) -> bool {
+        match self {
+            DepthFunc::Never => false,
+            DepthFunc::Less => fragment < stored,
+            DepthFunc::Equal => fragment == stored,
+            DepthFunc::LessEqual => fragment <= stored,
+            DepthFunc::Greater => fragment > stored,
+            DepthFunc::NotEqual => fragment != stored,
+            DepthFunc::GreaterEqual => fragment >= stored,
+            DepthFunc::Always => true,
+        }
+    }
+}
+
+/// How a fragment's colour combines with the stored one (all in linear space).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum BlendMode {
+    /// `dst = src`.
+    #[default]
+    Replace,
+    /// Porter–Duff "over" with premultiplied colours: `dst = src + dst × (1 − src.a)`.
+    PremultipliedOver,
+    /// Classic alpha blending: `dst.rgb = src.rgb × src.a + dst.rgb × (1 − src.a)`,
+    /// `dst.a = src.a + dst.a × (1 − src.a)`.
+    Alpha,
+    /// `dst = src + dst`.
+    Additive,
+}
+
+impl BlendMode {
+    /// The blended colour.
+    #[inline]
+    pub fn blend(self, src: Vec4, dst: Vec4) -> Vec4 {
+        match self {
+            BlendMode::Replace => src,
+            BlendMode::PremultipliedOver => src + dst * (1.0 - src.w),
+            BlendMode::Alpha => {
+                let a = src.w;
+                let rgb = src.truncate() * a + dst.truncate() * (1.0 - a);
+                rgb.extend(a + dst.w * (1.0 - a))
+            }
+            BlendMode::Additive => src + dst,
+        }
+    }
+}
+
+/// One tile's colour and depth, `TILE_SIZE × TILE_SIZE`, row-major within the tile.
+#[derive(Clone, Debug)]
+pub struct TileBuffer {
+    /// Linear RGBA.
+    pub color: Vec<Vec4>,
+    /// Window depth.
+    pub depth: Vec<f32>,
+}
+
+impl TileBuffer {
+    fn new() -> Self {
+        Self {
+            color: vec![Vec4::ZERO; TILE_PIXELS],
+            depth: vec![1.0; TILE_PIXELS],
+        }
+    }
+
+    /// Index of absolute pixel `(x, y)` within the tile (the tile's origin is a multiple of
+    /// `TILE_SIZE`).
+    #[inline]
+    pub fn index(x: i32, y: i32) -> usize {
+        let mask = TILE_SIZE as i32 - 1;
+        (((y & mask) << TILE_LOG2) | (x & mask)) as usize
+    }
+}
+
+/// A colour + depth target stored as tiles.
+#[derive(Clone, Debug)]
+pub struct Framebuffer {
+    grid: TileGrid,
+    tiles: Vec<TileBuffer>,
+}
+
+impl Framebuffer {
+    /// A target of `width × height` (sizes checked by the caller), cleared to transparent black
+    /// and depth 1.
+    pub(crate) fn new(width: u32, height: u32) -> Self {
+        let grid = TileGrid::new(width, height);
+        Self {
+            grid,
+            tiles: (0..grid.tile_count()).map(|_| TileBuffer::new()).collect(),
+        }
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.grid.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.grid.height
+    }
+
+    /// The tile layout.
+    pub fn grid(&self) -> &TileGrid {
+        &self.grid
+    }
+
+    pub(crate) fn tiles_mut(&mut self) -> &mut [TileBuffer] {
+        &mut self.tiles
+    }
+
+    /// Sets every pixel's colour and/or depth.
+    pub fn clear(&mut self, color: Option<Vec4>, depth: Option<f32>) {
+        use rayon::prelude::*;
+        self.tiles.par_iter_mut().for_each(|tile| {
+            if let Some(c) = color {
+                tile.color.fill(c);
+            }
+            if let Some(d) = depth {
+                tile.depth.fill(d);
+            }
+        });
+    }
+
+    fn read<T: Copy>(&self, mut get: impl FnMut(&TileBuffer, usize) -> T) -> Vec<T> {
+        let (w, h) = (self.grid.width as usize, self.grid.height as usize);
+        let mut out = Vec::with_capacity(w * h);
+        for y in 0..h {
+            for x in 0..w {
+                let tile = (y >> TILE_LOG2) * self.grid.tiles_x as usize + (x >> TILE_LOG2);
+                out.push(get(
+                    &self.tiles[tile],
+                    TileBuffer::index(x as i32, y as i32),
+                ));
+            }
+        }
+        out
+    }
+
+    /// Linear RGBA, row-major, row 0 = top.
+    pub fn read_color(&self) -> Vec<[f32; 4]> {
+        self.read(|t, i| t.color[i].to_array())
+    }
+
+    /// 8-bit RGBA, row-major, row 0 = top; RGB sRGB-encoded when `srgb` is set.
+    pub fn read_rgba8(&self, srgb: bool) -> Vec<u8> {
+        self.read(|t, i| crate::color::encode_rgba8(t.color[i].to_array(), srgb))
+            .into_iter()
+            .flatten()
+            .collect()
+    }
+
+    /// Window depth, row-major, row 0 = top.
+    pub fn read_depth(&self) -> Vec<f32> {
+        self.read(|t, i| t.depth[i])
+    }
+
+    /// Colour of one pixel (`None` outside the target).
+    pub fn pixel(&self, x: u32, y: u32) -> Option<Vec4> {
+        if x >= self.grid.width || y >= self.grid.height {
+            return None;
+        }
+        let tile =
+            (y >> TILE_LOG2) as usize * self.grid.tiles_x as usize + (x >> TILE_LOG2) as usize;
+        Some(self.tiles[tile].color[TileBuffer::index(x as i32, y as i32)])
+    }
+
+    /// Depth of one pixel (`None` outside the target).
+    pub fn depth_at(&self, x: u32, y: u32) -> Option<f32> {
+        if x >= self.grid.width || y >= self.grid.height {
+            return None;
+        }
+        let tile =
+            (y >> TILE_LOG2) as usize * self.grid.tiles_x as usize + (x >> TILE_LOG2) as usize;
+        Some(self.tiles[tile].depth[TileBuffer::index(x as i32, y as i32)])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn depth_functions() {
+        use DepthFunc::*;
+        let cases = [
+            (Never, [false, false, false]),
+            (Less, [true, false, false]),
+            (Equal, [false, true, false]),
+            (LessEqual, [true, true, false]),
+            (Greater, [false, false, true]),
+            (NotEqual, [true, false, true]),
+            (GreaterEqual, [false, true, true]),
+            (Always, [true, true, true]),
+        ];
+        for (f, expected) in cases {
+            assert_eq!(
+                [f.passes(0.2, 0.5), f.passes(0.5, 0.5), f.passes(0.7, 0.5)],
+                expected,
+                "{f:?}"
+            );
+        }
+    }
+
+    #[test]
+    fn blend_modes() {
+        let dst = Vec4::new(0.0, 0.0, 1.0, 1.0);
+        let red_half = Vec4::new(1.0, 0.0, 0.0, 0.5);
+        assert_eq!(BlendMode::Replace.blend(red_half, dst), red_half);
+        assert_eq!(
+            BlendMode::Alpha.blend(red_half, dst),
+            Vec4::new(0.5, 0.0, 0.5, 1.0)
+        );
+        let premultiplied = Vec4::new(0.5, 0.0, 0.0, 0.5);
+        assert_eq!(
+            BlendMode::PremultipliedOver.blend(premultiplied, dst),
+            Vec4::new(0.5, 0.0, 0.5, 1.0)
+        );
+        assert_eq!(
+            BlendMode::Additive.blend(red_half, dst),
+            Vec4::new(1.0, 0.0, 1.0, 1.5)
+        );
+    }
+
+    #[test]
+    fn framebuffer_reads_back_row_major() {
+        let mut fb = Framebuffer::new(70, 3);
+        fb.clear(Some(Vec4::ONE), Some(0.25));
+        let c = fb.read_color();
+        assert_eq!(c.len(), 210);
+        assert!(c.iter().all(|p| *p == [1.0; 4]));
+        assert_eq!(fb.read_depth()[209], 0.25);
+        assert_eq!(fb.read_rgba8(true).len(), 840);
+    }
+}

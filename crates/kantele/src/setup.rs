@@ -1,0 +1,421 @@
+//! Triangle setup: viewport transform, snapping to the sub-pixel grid, orientation and face
+//! culling, integer edge functions with the top-left fill rule folded in as a bias, and the
+//! data the fragment stage needs for perspective-correct interpolation.
+//!
+//! Takes three clip-space positions (already clipped to the near plane and guard band) and
+//! hands a [`TriangleSetup`] to binning and traversal. The record is plain old data
+//! (`#[repr(C)]`, no pointers) so a GPU backend can consume the same layout.
+
+use glam::Vec4;
+
+use crate::fixed::{pixel_center, snap, SUBPIXEL_ONE};
+
+/// Which faces are removed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum CullMode {
+    /// Draw both faces.
+    None,
+    /// Remove back faces.
+    #[default]
+    Back,
+    /// Remove front faces.
+    Front,
+}
+
+/// Which winding (in normalized device coordinates, y up) is the front face.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum FrontFace {
+    /// Counter-clockwise is front (OpenGL's and glTF's default).
+    #[default]
+    Ccw,
+    /// Clockwise is front.
+    Cw,
+}
+
+/// A half-open rectangle of pixels `[x0, x1) × [y0, y1)`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct PixelRect {
+    /// First column.
+    pub x0: i32,
+    /// First row.
+    pub y0: i32,
+    /// One past the last column.
+    pub x1: i32,
+    /// One past the last row.
+    pub y1: i32,
+}
+
+impl PixelRect {
+    /// Whether the rectangle holds no pixel.
+    pub fn is_empty(&self) -> bool {
+        self.x0 >= self.x1 || self.y0 >= self.y1
+    }
+
+    /// The overlap of two rectangles (possibly empty).
+    pub fn intersect(&self, other: &PixelRect) -> PixelRect {
+        PixelRect {
+            x0: self.x0.max(other.x0),
+            y0: self.y0.max(other.y0),
+            x1: self.x1.min(other.x1),
+            y1: self.y1.min(other.y1),
+        }
+    }
+
+    /// Width in pixels (0 when empty).
+    pub fn width(&self) -> i32 {
+        (self.x1 - self.x0).max(0)
+    }
+
+    /// Height in pixels (0 when empty).
+    pub fn height(&self) -> i32 {
+        (self.y1 - self.y0).max(0)
+    }
+}
+
+/// An integer edge function `E(x, y) = a·x + b·y + c` over sub-pixel coordinates, positive
+/// inside the triangle. `bias` is 0 for top and left edges and −1 otherwise, so that a sample is
+/// covered exactly when `E + bias ≥ 0` (the top-left rule without a per-pixel branch).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct EdgeFunction {
+    /// Coefficient of x (= y_from − y_to), sub-pixel units.
+    pub a: i64,
+    /// Coefficient of y (= x_to − x_from), sub-pixel units.
+    pub b: i64,
+    /// Constant term, sub-pixel units squared.
+    pub c: i64,
+    /// Fill-rule bias: 0 or −1.
+    pub bias: i64,
+}
+
+impl EdgeFunction {
+    /// The edge from `p` to `q` (sub-pixel coordinates), inside to its right in image
+    /// coordinates (y down), for triangles with positive [`TriangleSetup::area2`].
+    fn new(p: (i64, i64), q: (i64, i64)) -> Self {
+        let a = p.1 - q.1;
+        let b = q.0 - p.0;
+        let c = -(a * p.0 + b * p.1);
+        // With y down and positive area, a top edge runs exactly horizontally to the right
+        // (a == 0, b > 0) and a left edge runs upwards (a > 0).
+        let top_left = a > 0 || (a == 0 && b > 0);
+        Self {
+            a,
+            b,
+            c,
+            bias: if top_left { 0 } else { -1 },
+        }
+    }
+
+    /// The unbiased value at the centre of pixel `(x, y)`.
+    #[inline]
+    pub fn at_pixel(&self, x: i32, y: i32) -> i64 {
+        self.a * pixel_center(x as i64) + self.b * pixel_center(y as i64) + self.c
+    }
+
+    /// The biased value at the centre of pixel `(x, y)`: covered when `≥ 0`.
+    #[inline]
+    pub fn biased_at_pixel(&self, x: i32, y: i32) -> i64 {
+        self.at_pixel(x, y) + self.bias
+    }
+
+    /// Change of the value per pixel step in x.
+    #[inline]
+    pub fn step_x(&self) -> i64 {
+        self.a * SUBPIXEL_ONE
+    }
+
+    /// Change of the value per pixel step in y.
+    #[inline]
+    pub fn step_y(&self) -> i64 {
+        self.b * SUBPIXEL_ONE
+    }
+}
+
+/// Everything traversal and fragment processing need about one triangle.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct TriangleSetup {
+    /// Edge functions; edge `i` is opposite vertex `i`, so `λ_i = E_i / area2`.
+    pub edges: [EdgeFunction; 3],
+    /// Twice the signed area in sub-pixel units squared (> 0 after orientation).
+    pub area2: i64,
+    /// Pixels whose centres may be covered, clamped to the target.
+    pub bbox: PixelRect,
+    /// Snapped vertex positions (sub-pixel units), after orientation.
+    pub pos_subpixel: [[i64; 2]; 3],
+    /// Window depth `(z/w + 1) / 2` of each vertex.
+    pub depth: [f32; 3],
+    /// `1 / w_clip` of each vertex.
+    pub inv_w: [f32; 3],
+    /// `1 / area2` as `f32`.
+    pub inv_area2: f32,
+    /// Index of the draw in the frame.
+    pub draw: u32,
+    /// Index of the source triangle within its draw.
+    pub primitive_id: u32,
+    /// Whether the triangle is front-facing.
+    pub front_facing: bool,
+    /// Whether vertices 1 and 2 were swapped to make the area positive (varyings follow).
+    pub swapped: bool,
+}
+
+/// Why setup produced no triangle.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SetupReject {
+    /// Removed by face culling.
+    Culled,
+    /// Zero area after snapping, or no pixel centre inside its box on the target.
+    Degenerate,
+}
+
+/// Maps clip space to window coordinates for a `width × height` target (row 0 at the top).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Viewport {
+    half_width: f32,
+    half_height: f32,
+    /// Target width in pixels.
+    pub width: u32,
+    /// Target height in pixels.
+    pub height: u32,
+}
+
+impl Viewport {
+    /// The viewport covering a whole `width × height` target.
+    pub fn new(width: u32, height: u32) -> Self {
+        Self {
+            half_width: width as f32 * 0.5,
+            half_height: height as f32 * 0.5,
+            width,
+            height,
+        }
+    }
+
+    /// Window coordinates `(x, y, depth)` and `1/w` of a clip-space position with `w > 0`.
+    /// `x = x_ndc·W/2 + W/2` and `y = −y_ndc·H/2 + H/2` (the image's top row is NDC y = +1).
+    #[inline]
+    pub fn to_window(&self, pos_clip: Vec4) -> ([f32; 3], f32) {
+        let inv_w = 1.0 / pos_clip.w;
+        let x_ndc = pos_clip.x * inv_w;
+        let y_ndc = pos_clip.y * inv_w;
+        let z_ndc = pos_clip.z * inv_w;
+        (
+            [
+                x_ndc * self.half_width + self.half_width,
+                -y_ndc * self.half_height + self.half_height,
+                z_ndc * 0.5 + 0.5,
+            ],
+            inv_w,
+        )
+    }
+
+    /// The whole target as a pixel rectangle.
+    pub fn rect(&self) -> PixelRect {
+        PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: self.width as i32,
+            y1: self.height as i32,
+        }
+    }
+}
+
+/// Sets up one triangle from clip-space positions (each with `w > 0`, inside the guard band).
+pub fn setup_triangle(
+    viewport: &Viewport,
+    pos_clip: [Vec4; 3],
+    cull: CullMode,
+    front_face: FrontFace,
+) -> Result<TriangleSetup, SetupReject> {
+    let mut window = [[0.0f32; 3]; 3];
+    let mut inv_w = [0.0f32; 3];
+    for i in 0..3 {
+        (window[i], inv_w[i]) = viewport.to_window(pos_clip[i]);
+    }
+    let mut pos: [[i64; 2]; 3] = [
+        [snap(window[0][0]), snap(window[0][1])],
+        [snap(window[1][0]), snap(window[1][1])],
+        [snap(window[2][0]), snap(window[2][1])],
+    ];
+    let mut area2 = (pos[1][0] - pos[0][0]) * (pos[2][1] - pos[0][1])
+        - (pos[2][0] - pos[0][0]) * (pos[1][1] - pos[0][1]);
+    if area2 == 0 {
+        return Err(SetupReject::Degenerate);
+    }
+    // Window y points down, so a counter-clockwise triangle in NDC has negative area here.
+    let ccw = area2 < 0;
+    let front_facing = match front_face {
+        FrontFace::Ccw => ccw,
+        FrontFace::Cw => !ccw,
+    };
+    match (cull, front_facing) {
+        (CullMode::Back, false) | (CullMode::Front, true) => return Err(SetupReject::Culled),
+        _ => {}
+    }
+    let mut depth = [window[0][2], window[1][2], window[2][2]];
+    let swapped = area2 < 0;
+    if swapped {
+        pos.swap(1, 2);
+        depth.swap(1, 2);
+        inv_w.swap(1, 2);
+        area2 = -area2;
+    }
+    let p = |i: usize| (pos[i][0], pos[i][1]);
+    let edges = [
+        EdgeFunction::new(p(1), p(2)),
+        EdgeFunction::new(p(2), p(0)),
+        EdgeFunction::new(p(0), p(1)),
+    ];
+    // Pixel x is a candidate when its centre x·256 + 128 lies within [min, max].
+    let min_x = pos.iter().map(|v| v[0]).min().unwrap_or(0);
+    let max_x = pos.iter().map(|v| v[0]).max().unwrap_or(0);
+    let min_y = pos.iter().map(|v| v[1]).min().unwrap_or(0);
+    let max_y = pos.iter().map(|v| v[1]).max().unwrap_or(0);
+    let first =
+        |min: i64| (min - crate::fixed::SUBPIXEL_HALF + SUBPIXEL_ONE - 1).div_euclid(SUBPIXEL_ONE);
+    let last = |max: i64| (max - crate::fixed::SUBPIXEL_HALF).div_euclid(SUBPIXEL_ONE);
+    let bbox = PixelRect {
+        x0: first(min_x) as i32,
+        y0: first(min_y) as i32,
+        x1: last(max_x) as i32 + 1,
+        y1: last(max_y) as i32 + 1,
+    }
+    .intersect(&viewport.rect());
+    if bbox.is_empty() {
+        return Err(SetupReject::Degenerate);
+    }
+    Ok(TriangleSetup {
+        edges,
+        area2,
+        bbox,
+        pos_subpixel: pos,
+        depth,
+        inv_w,
+        inv_area2: 1.0 / area2 as f32,
+        draw: 0,
+        primitive_id: 0,
+        front_facing,
+        swapped,
+    })
+}
+
+impl TriangleSetup {
+    /// Whether the centre of pixel `(x, y)` is covered (top-left rule included).
+    #[inline]
+    pub fn covers(&self, x: i32, y: i32) -> bool {
+        self.edges.iter().all(|e| e.biased_at_pixel(x, y) >= 0)
+    }
+
+    /// Screen-space barycentric weights `λ_i = E_i / area2` at the centre of pixel `(x, y)`.
+    #[inline]
+    pub fn barycentrics(&self, x: i32, y: i32) -> [f32; 3] {
+        [
+            self.edges[0].at_pixel(x, y) as f32 * self.inv_area2,
+            self.edges[1].at_pixel(x, y) as f32 * self.inv_area2,
+            self.edges[2].at_pixel(x, y) as f32 * self.inv_area2,
+        ]
+    }
+
+    /// Window depth at the given barycentrics (affine in screen space).
+    #[inline]
+    pub fn depth_at(&self, bary: &[f32; 3]) -> f32 {
+        bary[0] * self.depth[0] + bary[1] * self.depth[1] + bary[2] * self.depth[2]
+    }
+
+    /// Per-pixel derivatives of the screen-space barycentrics: `(dλ/dx, dλ/dy)`.
+    #[inline]
+    pub fn barycentric_gradients(&self) -> ([f32; 3], [f32; 3]) {
+        let s = SUBPIXEL_ONE as f32 * self.inv_area2;
+        (
+            [
+                self.edges[0].a as f32 * s,
+                self.edges[1].a as f32 * s,
+                self.edges[2].a as f32 * s,
+            ],
+            [
+                self.edges[0].b as f32 * s,
+                self.edges[1].b as f32 * s,
+                self.edges[2].b as f32 * s,
+            ],
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ndc(x: f32, y: f32) -> Vec4 {
+        Vec4::new(x, y, 0.0, 1.0)
+    }
+
+    #[test]
+    fn ccw_triangle_is_front_facing_and_cw_is_culled() {
+        let vp = Viewport::new(16, 16);
+        let ccw = [ndc(-0.5, -0.5), ndc(0.5, -0.5), ndc(0.0, 0.5)];
+        let t = setup_triangle(&vp, ccw, CullMode::Back, FrontFace::Ccw).expect("front face");
+        assert!(t.front_facing);
+        assert!(t.area2 > 0);
+        let cw = [ccw[0], ccw[2], ccw[1]];
+        assert_eq!(
+            setup_triangle(&vp, cw, CullMode::Back, FrontFace::Ccw),
+            Err(SetupReject::Culled)
+        );
+        let back = setup_triangle(&vp, cw, CullMode::None, FrontFace::Ccw).expect("not culled");
+        assert!(!back.front_facing);
+        assert_eq!(
+            setup_triangle(&vp, ccw, CullMode::Front, FrontFace::Ccw),
+            Err(SetupReject::Culled)
+        );
+    }
+
+    #[test]
+    fn barycentrics_sum_to_one_and_are_one_at_vertices() {
+        let vp = Viewport::new(64, 64);
+        let t = setup_triangle(
+            &vp,
+            [ndc(-1.0, -1.0), ndc(1.0, -1.0), ndc(-1.0, 1.0)],
+            CullMode::None,
+            FrontFace::Ccw,
+        )
+        .expect("valid");
+        let b = t.barycentrics(10, 20);
+        assert!((b.iter().sum::<f32>() - 1.0).abs() < 1e-6);
+        for (i, v) in t.pos_subpixel.iter().enumerate() {
+            let e = t.edges[i];
+            let value = e.a * v[0] + e.b * v[1] + e.c;
+            assert_eq!(value, t.area2);
+        }
+    }
+
+    #[test]
+    fn zero_area_is_degenerate() {
+        let vp = Viewport::new(16, 16);
+        let line = [ndc(-0.5, -0.5), ndc(0.0, 0.0), ndc(0.5, 0.5)];
+        assert_eq!(
+            setup_triangle(&vp, line, CullMode::None, FrontFace::Ccw),
+            Err(SetupReject::Degenerate)
+        );
+    }
+
+    #[test]
+    fn top_left_rule_on_a_pixel_aligned_square() {
+        // Square [2, 6) × [2, 6) in pixels, split along the diagonal: the pixel centres on the
+        // right and bottom boundaries are not covered, those on the left and top are.
+        let vp = Viewport::new(8, 8);
+        let to_ndc = |x: f32, y: f32| ndc(x / 4.0 - 1.0, 1.0 - y / 4.0);
+        let a = to_ndc(2.5, 2.5);
+        let b = to_ndc(6.5, 2.5);
+        let c = to_ndc(6.5, 6.5);
+        let d = to_ndc(2.5, 6.5);
+        let t1 = setup_triangle(&vp, [a, d, c], CullMode::None, FrontFace::Ccw).expect("t1");
+        let t2 = setup_triangle(&vp, [a, c, b], CullMode::None, FrontFace::Ccw).expect("t2");
+        for y in 0..8 {
+            for x in 0..8 {
+                let n = t1.covers(x, y) as u32 + t2.covers(x, y) as u32;
+                let inside = (2..6).contains(&x) && (2..6).contains(&y);
+                assert_eq!(n, inside as u32, "pixel ({x}, {y})");
+            }
+        }
+    }
+}
