@@ -452,12 +452,7 @@ impl GlBackend {
                     }
                 }
                 gl.bind_vertex_array(Some(gpu_mesh.vertex_array));
-                gl.draw_elements(
-                    glow::TRIANGLES,
-                    gpu_mesh.index_count,
-                    glow::UNSIGNED_INT,
-                    0,
-                );
+                gl.draw_elements(glow::TRIANGLES, gpu_mesh.index_count, glow::UNSIGNED_INT, 0);
             }
             gl.bind_vertex_array(None);
             gl.depth_mask(true);
@@ -543,7 +538,11 @@ impl Backend for GlBackend {
     fn read_frame(&mut self) -> Result<FrameImage, RenderError> {
         let target = match (&self.target, self.last_pass) {
             (Some(t), Some(_)) => t,
-            _ => return Err(backend_error("read_frame called before a frame was rendered")),
+            _ => {
+                return Err(backend_error(
+                    "read_frame called before a frame was rendered",
+                ))
+            }
         };
         self.make_current()?;
         let (width, height) = (target.width, target.height);
