@@ -102,8 +102,13 @@ impl EglContext {
     /// [`crate::GlBackend::new`]). The error lists every attempt.
     pub(crate) fn new() -> Result<Self, String> {
         // SAFETY: libEGL.so.1 is the system's EGL library (glvnd or Mesa); loading it runs its
-        // initialisers, which is what every EGL program does.
-        let egl = unsafe { Egl::load_required() }
+        // initialisers, which is what every EGL program does. (`Egl::load_required` would also
+        // open the development link libEGL.so even when libEGL.so.1 loads.)
+        let egl = unsafe { Egl::load_required_from_filename("libEGL.so.1") }
+            .or_else(|first| {
+                // SAFETY: as above.
+                unsafe { Egl::load_required_from_filename("libEGL.so") }.map_err(|_| first)
+            })
             .map_err(|e| format!("cannot load libEGL.so.1 (EGL 1.4): {e}"))?;
         let client_extensions = egl
             .query_string(None, egl::EXTENSIONS)

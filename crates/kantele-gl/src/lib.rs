@@ -31,6 +31,13 @@
 //!   0 and never blend; MASK discards as in the colour pass and BLEND geometry is drawn without
 //!   depth writes (it overwrites what lies behind it).
 //!
+//! # What a machine needs
+//!
+//! Nothing at build time (`libEGL.so.1` is opened with `dlopen`). At run time on Debian/Ubuntu:
+//! `apt-get install libegl1 libegl-mesa0 libgl1-mesa-dri` (glvnd's libEGL, Mesa's EGL vendor
+//! library, and the DRI drivers with llvmpipe); neither libGL nor libGLES is used. Without them
+//! [`GlBackend::new`] returns an error and the tests skip.
+//!
 //! # Threads
 //!
 //! A GL context is current on one thread at a time: [`GlBackend`] is neither `Send` nor `Sync`
@@ -141,7 +148,11 @@ impl GlBackend {
     /// Fails with [`RenderError::Backend`] (never panics) when EGL, a display or a context is not
     /// available; the message lists every attempt.
     pub fn new() -> Result<Self, RenderError> {
-        let egl = EglContext::new().map_err(backend_error)?;
+        // EGL wrappers unwrap a few driver answers (an error code EGL does not define); a broken
+        // driver must still only make `new` fail, so a panic in there is caught and reported.
+        let egl = std::panic::catch_unwind(EglContext::new)
+            .unwrap_or_else(|_| Err("EGL set-up panicked (broken EGL driver?)".into()))
+            .map_err(backend_error)?;
         // SAFETY: the context was just made current on this thread; the loader returns EGL's
         // addresses for GL functions (null for unknown ones, which glow tolerates).
         let gl = unsafe { glow::Context::from_loader_function(|name| egl.proc_address(name)) };
@@ -512,10 +523,8 @@ impl Backend for GlBackend {
             .clone()
             .ok_or_else(|| backend_error("render called before load"))?;
         let (width, height) = (view.width, view.height);
-        if width == 0 || height == 0 || width > kantele::MAX_TARGET_SIZE {
-            return Err(RenderError::InvalidSize { width, height });
-        }
-        if height > kantele::MAX_TARGET_SIZE {
+        let side_ok = |s: u32| (1..=kantele::MAX_TARGET_SIZE).contains(&s);
+        if !side_ok(width) || !side_ok(height) {
             return Err(RenderError::InvalidSize { width, height });
         }
         if self.fast_target && view.pass != Pass::Color {
