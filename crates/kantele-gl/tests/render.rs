@@ -549,3 +549,52 @@ fn two_backends_on_one_thread_and_on_two_threads() {
     a.render(&view(Vec3::Z)).unwrap();
     assert_eq!(px(&a.read_frame().unwrap(), 0, 0), red);
 }
+
+#[test]
+fn minification_reads_the_uploaded_mip_levels() {
+    let Some(mut gl) = backend() else { return };
+    // A 256 × 256 texture on a 64 × 64 image: one pixel spans 4 texels, λ = 2, so
+    // NEAREST_MIPMAP_NEAREST reads level 2 (64 × 64) and pixel (x, y) lands on its texel (x, y).
+    let size = 256u32;
+    let texels = (0..size * size)
+        .map(|i| {
+            let (x, y) = (i % size, i / size);
+            let h = (x.wrapping_mul(2_654_435_761) ^ y.wrapping_mul(40_503)) % 1000;
+            Vec4::new(
+                x as f32 / size as f32,
+                y as f32 / size as f32,
+                h as f32 / 1000.0,
+                1.0,
+            )
+        })
+        .collect();
+    let texture = Arc::new(Texture::from_rgba_f32(size, size, texels).expect("texture"));
+    let sampler = Sampler {
+        wrap_s: Wrap::Repeat,
+        wrap_t: Wrap::Repeat,
+        mag_filter: Filter::Nearest,
+        min_filter: MinFilter::NearestMipmapNearest,
+    };
+    let material = Material {
+        base_color_texture: Some(TextureBinding {
+            texture: 0,
+            sampler,
+        }),
+        unlit: true,
+        ..Material::default()
+    };
+    let mut s = scene(vec![full(0.0, 0)], vec![material]);
+    s.textures = vec![texture.clone()];
+    let mut v = view(Vec3::Z);
+    v.width = 64;
+    v.height = 64;
+    let img = render(&mut gl, s, &v);
+    let level = &texture.levels()[2];
+    assert_eq!((level.width, level.height), (64, 64));
+    for y in 0..64 {
+        for x in 0..64 {
+            let expected = level.texels[(y * 64 + x) as usize];
+            assert_close(px(&img, x, y), expected, 1e-6, &format!("({x}, {y})"));
+        }
+    }
+}
