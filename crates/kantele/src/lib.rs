@@ -9,6 +9,7 @@ pub mod cpu;
 pub mod error;
 pub mod fixed;
 pub mod geometry;
+pub mod material;
 pub mod pipeline;
 pub mod raster;
 pub mod rop;

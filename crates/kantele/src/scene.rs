@@ -35,6 +35,40 @@ impl Mesh {
         self.indices.len() / 3
     }
 
+    /// The mesh with one vertex per triangle corner and every normal set to its face normal
+    /// `normalize((b − a) × (c − a))` (object space; counter-clockwise faces point outwards).
+    /// Zero-area faces get +Z. Used for meshes without normals.
+    pub fn flat_shaded(&self) -> Mesh {
+        let n = self.indices.len();
+        let mut out = Mesh {
+            name: self.name.clone(),
+            positions: Vec::with_capacity(n),
+            normals: Some(Vec::with_capacity(n)),
+            texcoords: self.texcoords.as_ref().map(|_| Vec::with_capacity(n)),
+            colors: self.colors.as_ref().map(|_| Vec::with_capacity(n)),
+            indices: (0..n as u32).collect(),
+            material: self.material,
+        };
+        let get = |i: u32| self.positions.get(i as usize).copied().unwrap_or(Vec3::NAN);
+        for tri in self.indices.chunks_exact(3) {
+            let [a, b, c] = [get(tri[0]), get(tri[1]), get(tri[2])];
+            let normal = (b - a).cross(c - a).try_normalize().unwrap_or(Vec3::Z);
+            for &i in tri {
+                out.positions.push(get(i));
+                if let Some(normals) = &mut out.normals {
+                    normals.push(normal);
+                }
+                if let (Some(dst), Some(src)) = (&mut out.texcoords, &self.texcoords) {
+                    dst.push(src.get(i as usize).copied().unwrap_or(Vec2::ZERO));
+                }
+                if let (Some(dst), Some(src)) = (&mut out.colors, &self.colors) {
+                    dst.push(src.get(i as usize).copied().unwrap_or(Vec4::ONE));
+                }
+            }
+        }
+        out
+    }
+
     /// Object-space bounding box `(min, max)` of the referenced positions, ignoring non-finite
     /// ones; `None` when there are none.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {

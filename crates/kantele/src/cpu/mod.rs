@@ -1,26 +1,54 @@
-//! The CPU backend: the software pipeline behind the [`Backend`] interface.
+//! The CPU backend: scenes drawn through the software [`pipeline`](crate::pipeline) with the
+//! built-in [`material`](crate::material) shaders, behind the [`Backend`] interface.
 
 use std::sync::Arc;
 
-use crate::backend::{Backend, FrameImage, FrameView};
+use crate::backend::{Backend, FrameImage, FrameView, Pass};
 use crate::error::RenderError;
+use crate::material::{Lighting, MaterialShader, StandardVertex};
+use crate::pipeline::{Indices, Renderer, RendererOptions};
 use crate::raster::Strategy;
-use crate::scene::Scene;
+use crate::scene::{Mesh, Scene};
 use crate::stats::FrameStats;
 
 /// Options of the CPU backend.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub struct CpuOptions {
-    /// Worker threads; `None` uses every core.
-    pub threads: Option<usize>,
-    /// Triangle traversal strategy.
-    pub strategy: Strategy,
+pub type CpuOptions = RendererOptions;
+
+/// A mesh converted once, at load time, to the vertex layout the shaders read.
+struct PreparedMesh {
+    vertices: Vec<StandardVertex>,
+    indices: Vec<u32>,
+}
+
+impl PreparedMesh {
+    fn new(mesh: &Mesh) -> Self {
+        let flat;
+        let mesh = if mesh.normals.is_none() {
+            flat = mesh.flat_shaded();
+            &flat
+        } else {
+            mesh
+        };
+        let vertices = (0..mesh.positions.len())
+            .map(|i| StandardVertex {
+                position: mesh.positions[i],
+                normal: mesh.normals.as_ref().map_or(glam::Vec3::Z, |n| n[i]),
+                texcoord: mesh.texcoords.as_ref().map_or(glam::Vec2::ZERO, |t| t[i]),
+                color: mesh.colors.as_ref().map_or(glam::Vec4::ONE, |c| c[i]),
+            })
+            .collect();
+        Self {
+            vertices,
+            indices: mesh.indices.clone(),
+        }
+    }
 }
 
 /// Renders scenes with Kantele's CPU pipeline.
 pub struct CpuBackend {
     options: CpuOptions,
-    scene: Option<Arc<Scene>>,
+    renderer: Renderer,
+    scene: Option<(Arc<Scene>, Vec<PreparedMesh>)>,
 }
 
 impl CpuBackend {
@@ -28,8 +56,25 @@ impl CpuBackend {
     pub fn new(options: CpuOptions) -> Result<Self, RenderError> {
         Ok(Self {
             options,
+            renderer: Renderer::new(1, 1, options)?,
             scene: None,
         })
+    }
+
+    /// The traversal strategy in use.
+    pub fn strategy(&self) -> Strategy {
+        self.renderer.strategy()
+    }
+
+    /// Changes the traversal strategy (pictures stay identical).
+    pub fn set_strategy(&mut self, strategy: Strategy) {
+        self.options.strategy = strategy;
+        self.renderer.set_strategy(strategy);
+    }
+
+    /// The underlying renderer (framebuffer access).
+    pub fn renderer(&self) -> &Renderer {
+        &self.renderer
     }
 }
 
@@ -37,26 +82,81 @@ impl Backend for CpuBackend {
     fn name(&self) -> &str {
         "cpu"
     }
+
     fn renderer(&self) -> String {
-        format!("kantele cpu ({})", self.options.strategy.name())
+        format!(
+            "kantele cpu ({}, {} threads)",
+            self.renderer.strategy(),
+            self.renderer.threads()
+        )
     }
+
     fn threads(&self) -> usize {
-        self.options.threads.unwrap_or(1)
+        self.renderer.threads()
     }
+
     fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError> {
-        self.scene = Some(scene);
+        scene.validate()?;
+        let meshes = scene.meshes.iter().map(PreparedMesh::new).collect();
+        self.scene = Some((scene, meshes));
         Ok(())
     }
-    fn render(&mut self, _view: &FrameView) -> Result<FrameStats, RenderError> {
-        Err(RenderError::Unsupported {
-            backend: "cpu".into(),
-            message: "not yet".into(),
-        })
+
+    fn render(&mut self, view: &FrameView) -> Result<FrameStats, RenderError> {
+        let Some((scene, meshes)) = &self.scene else {
+            return Err(RenderError::InvalidScene("no scene loaded".into()));
+        };
+        self.renderer.resize(view.width, view.height)?;
+        let view_projection = view.projection * view.view;
+        let lighting = Lighting {
+            to_light: view.to_light,
+            light_color: view.light_color,
+            ambient: scene.ambient,
+        };
+        let shaders: Vec<MaterialShader<'_>> = scene
+            .draws
+            .iter()
+            .enumerate()
+            .map(|(i, draw)| {
+                let material = &scene.materials[scene.meshes[draw.mesh].material];
+                let texture = material
+                    .base_color_texture
+                    .map(|b| (&*scene.textures[b.texture], b.sampler));
+                MaterialShader::new(
+                    draw.model,
+                    view_projection,
+                    lighting,
+                    material,
+                    texture,
+                    view.pass,
+                    (draw.node_index as u32 + 1, i as u32 + 1),
+                )
+            })
+            .collect();
+        let clear = match view.pass {
+            Pass::Color => scene.clear_color,
+            Pass::Normals | Pass::Ids => glam::Vec4::ZERO,
+        };
+        let mut frame = self.renderer.begin_frame(Some(clear), Some(1.0));
+        for (draw, shader) in scene.draws.iter().zip(&shaders) {
+            let mesh = &meshes[draw.mesh];
+            frame.draw(
+                shader,
+                &mesh.vertices,
+                Indices::U32(&mesh.indices),
+                shader.render_state(),
+            )?;
+        }
+        Ok(frame.end())
     }
+
     fn read_frame(&mut self) -> Result<FrameImage, RenderError> {
-        Err(RenderError::Unsupported {
-            backend: "cpu".into(),
-            message: "not yet".into(),
+        let fb = self.renderer.framebuffer();
+        Ok(FrameImage {
+            width: fb.width(),
+            height: fb.height(),
+            color: fb.read_color(),
+            depth: fb.read_depth(),
         })
     }
 }

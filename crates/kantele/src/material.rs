@@ -1,0 +1,183 @@
+//! Built-in materials: shaders implementing exactly the shading rules of the reference scenes,
+//! so a loaded scene draws without user shaders.
+//!
+//! `base = baseColorFactor × COLOR_0 × texture(uv)`; unlit → `base`; otherwise Lambert
+//! `base.rgb × (ambient + (1 − ambient) × max(0, N·L) × light)`, with `N` the interpolated
+//! world normal renormalised per pixel and flipped on back faces of double-sided materials.
+//! Alpha: OPAQUE → 1, MASK → discard below the cutoff, BLEND → blended by the draw's state.
+
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
+
+use crate::backend::Pass;
+use crate::camera::normal_matrix;
+use crate::pipeline::{Fragment, RenderState, Shader};
+use crate::rop::BlendMode;
+use crate::scene::{AlphaMode, Material};
+use crate::setup::CullMode;
+use crate::shade::texture::{Sampler, Texture};
+
+/// The vertex layout of scene meshes.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct StandardVertex {
+    /// Object-space position.
+    pub position: Vec3,
+    /// Object-space normal.
+    pub normal: Vec3,
+    /// Texture coordinate, (0, 0) = top-left of the image.
+    pub texcoord: Vec2,
+    /// Linear RGBA vertex colour (white when the mesh has none).
+    pub color: Vec4,
+}
+
+/// Varyings: world normal (3), texcoord (2), colour (4).
+const VARYINGS: usize = 9;
+
+/// Light and camera shared by every draw of a frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lighting {
+    /// Unit vector towards the light, world space.
+    pub to_light: Vec3,
+    /// Light colour × intensity.
+    pub light_color: Vec3,
+    /// Ambient term.
+    pub ambient: f32,
+}
+
+/// The shader of one scene draw.
+pub struct MaterialShader<'a> {
+    model_view_projection: Mat4,
+    normal_matrix: Mat3,
+    lighting: Lighting,
+    material: &'a Material,
+    texture: Option<(&'a Texture, Sampler)>,
+    pass: Pass,
+    /// `(instance id, draw id)` for the id pass.
+    ids: (f32, f32),
+}
+
+impl<'a> MaterialShader<'a> {
+    /// The shader for a draw with object → world `model`, seen through `view_projection`.
+    /// `ids` are the instance id and draw id written by the id pass (both ≥ 1).
+    pub fn new(
+        model: Mat4,
+        view_projection: Mat4,
+        lighting: Lighting,
+        material: &'a Material,
+        texture: Option<(&'a Texture, Sampler)>,
+        pass: Pass,
+        ids: (u32, u32),
+    ) -> Self {
+        Self {
+            model_view_projection: view_projection * model,
+            normal_matrix: normal_matrix(&model),
+            lighting,
+            material,
+            texture,
+            pass,
+            ids: (ids.0 as f32, ids.1 as f32),
+        }
+    }
+
+    /// The fixed-function state the material asks for: culling unless double-sided, and for
+    /// BLEND alpha blending without depth writes (no blending outside the colour pass).
+    pub fn render_state(&self) -> RenderState {
+        let blend = matches!(self.material.alpha_mode, AlphaMode::Blend);
+        RenderState {
+            cull: if self.material.double_sided {
+                CullMode::None
+            } else {
+                CullMode::Back
+            },
+            depth_write: !blend,
+            blend: if blend && self.pass == Pass::Color {
+                BlendMode::Alpha
+            } else {
+                BlendMode::Replace
+            },
+            ..RenderState::default()
+        }
+    }
+
+    #[inline]
+    fn base_color(&self, fragment: &Fragment<'_>) -> Vec4 {
+        let v = fragment.varyings();
+        let color = Vec4::new(v[5], v[6], v[7], v[8]);
+        let mut base = self.material.base_color_factor * color;
+        if let Some((texture, sampler)) = self.texture {
+            let uv = Vec2::new(v[3], v[4]);
+            let (du_dx, du_dy) = fragment.derivatives(3);
+            let (dv_dx, dv_dy) = fragment.derivatives(4);
+            base *= texture.sample_grad(&sampler, uv, Vec2::new(du_dx, dv_dx), Vec2::new(du_dy, dv_dy));
+        }
+        base
+    }
+
+    #[inline]
+    fn normal(&self, fragment: &Fragment<'_>) -> Vec3 {
+        let v = fragment.varyings();
+        let n = Vec3::new(v[0], v[1], v[2]).normalize_or_zero();
+        if self.material.double_sided && !fragment.front_facing {
+            -n
+        } else {
+            n
+        }
+    }
+}
+
+impl Shader for MaterialShader<'_> {
+    type Vertex = StandardVertex;
+
+    fn varying_count(&self) -> usize {
+        VARYINGS
+    }
+
+    #[inline]
+    fn vertex(&self, vertex: &StandardVertex, varyings: &mut [f32]) -> Vec4 {
+        let n = self.normal_matrix * vertex.normal;
+        varyings[..3].copy_from_slice(&n.to_array());
+        varyings[3..5].copy_from_slice(&vertex.texcoord.to_array());
+        varyings[5..9].copy_from_slice(&vertex.color.to_array());
+        self.model_view_projection * vertex.position.extend(1.0)
+    }
+
+    #[inline]
+    fn fragment(&self, fragment: &Fragment<'_>) -> Option<Vec4> {
+        let needs_alpha = !matches!(self.material.alpha_mode, AlphaMode::Opaque);
+        if self.pass != Pass::Color && !needs_alpha {
+            return Some(self.auxiliary(fragment));
+        }
+        let base = self.base_color(fragment);
+        let alpha = match self.material.alpha_mode {
+            AlphaMode::Opaque => 1.0,
+            AlphaMode::Mask { cutoff } => {
+                if base.w < cutoff {
+                    return None;
+                }
+                1.0
+            }
+            AlphaMode::Blend => base.w,
+        };
+        if self.pass != Pass::Color {
+            return Some(self.auxiliary(fragment));
+        }
+        if self.material.unlit {
+            return Some(base.truncate().extend(alpha));
+        }
+        let l = self.lighting;
+        let n_dot_l = self.normal(fragment).dot(l.to_light).max(0.0);
+        let light = Vec3::splat(l.ambient) + (1.0 - l.ambient) * n_dot_l * l.light_color;
+        Some((base.truncate() * light).extend(alpha))
+    }
+}
+
+impl MaterialShader<'_> {
+    /// The value of the normals or ids pass.
+    #[inline]
+    fn auxiliary(&self, fragment: &Fragment<'_>) -> Vec4 {
+        match self.pass {
+            Pass::Normals => self.normal(fragment).extend(1.0),
+            _ => Vec4::new(self.ids.0, fragment.primitive_id as f32 + 1.0, self.ids.1, 1.0),
+        }
+    }
+}
