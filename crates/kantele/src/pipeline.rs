@@ -300,10 +300,10 @@ impl Renderer {
     /// Starts a frame: optionally clears colour and depth, then collects draws until
     /// [`Frame::end`].
     pub fn begin_frame<'a>(
-        &'a mut self,
+        &mut self,
         clear_color: Option<Vec4>,
         clear_depth: Option<f32>,
-    ) -> Frame<'a> {
+    ) -> Frame<'_, 'a> {
         Frame {
             renderer: self,
             clear_color,
@@ -320,15 +320,16 @@ fn check_target_size(width: u32, height: u32) -> Result<(), RenderError> {
     Ok(())
 }
 
-/// A frame being recorded: draws are queued in order and run by [`Frame::end`].
-pub struct Frame<'a> {
-    renderer: &'a mut Renderer,
+/// A frame being recorded: draws are queued in order and run by [`Frame::end`]. `'r` is the
+/// borrow of the renderer, `'a` that of the draws' shaders and buffers.
+pub struct Frame<'r, 'a> {
+    renderer: &'r mut Renderer,
     clear_color: Option<Vec4>,
     clear_depth: Option<f32>,
     draws: Vec<Box<dyn DrawJob + 'a>>,
 }
 
-impl<'a> Frame<'a> {
+impl<'a> Frame<'_, 'a> {
     /// Queues a draw of `indices` (or of the vertices in order) from `vertices` with `shader`
     /// and `state`. Checks the buffers now; nothing is drawn until [`Frame::end`].
     pub fn draw<S: Shader>(
