@@ -93,8 +93,40 @@ fn check_extensions(
     let mut json = document.into_json();
     json.extensions_required
         .retain(|e| SUPPORTED_EXTENSIONS.contains(&e.as_str()));
-    gltf::Document::from_json(json)
-        .map_err(|e| LoadError::invalid(path, format!("invalid glTF: {e}")))
+    validate(path, json, info)
+}
+
+/// Validates the document. Missing `min` / `max` on POSITION accessors (required by the spec,
+/// often left out by hand-written files, and unused here) only give a warning.
+fn validate(
+    path: &Path,
+    json: gltf::json::Root,
+    info: &mut SceneInfo,
+) -> Result<gltf::Document, LoadError> {
+    match gltf::Document::from_json(json.clone()) {
+        Ok(document) => Ok(document),
+        Err(gltf::Error::Validation(errors)) => {
+            let harmless = |(p, e): &(gltf::json::Path, gltf::json::validation::Error)| {
+                matches!(e, gltf::json::validation::Error::Missing)
+                    && (p.0.ends_with("[\"POSITION\"].min") || p.0.ends_with("[\"POSITION\"].max"))
+            };
+            if errors.iter().all(harmless) {
+                info.warn("POSITION accessors lack the min / max the glTF spec requires");
+                Ok(gltf::Document::from_json_without_validation(json))
+            } else {
+                let list: Vec<String> = errors
+                    .iter()
+                    .filter(|e| !harmless(e))
+                    .map(|(p, e)| format!("{p}: {e}"))
+                    .collect();
+                Err(LoadError::invalid(
+                    path,
+                    format!("invalid glTF: {}", list.join("; ")),
+                ))
+            }
+        }
+        Err(e) => Err(LoadError::invalid(path, e.to_string())),
+    }
 }
 
 /// Reads every buffer: the GLB binary chunk, external files or data URIs.
