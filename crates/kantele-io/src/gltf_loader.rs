@@ -299,10 +299,13 @@ impl Loader<'_> {
                 .warn("skins are not supported; meshes are drawn in their bind pose");
         }
         if document.animations().len() > 0 {
-            self.info.warn("animations are not supported and are ignored");
+            self.info
+                .warn("animations are not supported and are ignored");
         }
 
-        let Some(gltf_scene) = document.default_scene().or_else(|| document.scenes().next())
+        let Some(gltf_scene) = document
+            .default_scene()
+            .or_else(|| document.scenes().next())
         else {
             self.info.warn("the file has no scene: nothing is drawn");
             self.scene.camera = framing_camera(&self.scene);
@@ -317,10 +320,8 @@ impl Loader<'_> {
         let mut light = None;
         let mut visited = vec![false; document.nodes().len()];
         // Depth first, each node before its children, in file order.
-        let mut stack: Vec<(gltf::Node, Mat4)> = gltf_scene
-            .nodes()
-            .map(|n| (n, Mat4::IDENTITY))
-            .collect();
+        let mut stack: Vec<(gltf::Node, Mat4)> =
+            gltf_scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
         stack.reverse();
         while let Some((node, parent)) = stack.pop() {
             let index = node.index();
@@ -418,7 +419,10 @@ impl Loader<'_> {
             }
         };
         let numbers = |v: &serde_json::Value| -> Option<Vec<f64>> {
-            v.as_array()?.iter().map(serde_json::Value::as_f64).collect()
+            v.as_array()?
+                .iter()
+                .map(serde_json::Value::as_f64)
+                .collect()
         };
         if let Some(v) = value.get("resolution") {
             let max = kantele::MAX_TARGET_SIZE as f64;
@@ -449,9 +453,9 @@ impl Loader<'_> {
         if let Some(v) = value.get("ambient") {
             match v.as_f64() {
                 Some(a) if a.is_finite() => self.scene.ambient = a as f32,
-                _ => self
-                    .info
-                    .warn(format!("scene extras: ambient {v} is not a number; using 0.1")),
+                _ => self.info.warn(format!(
+                    "scene extras: ambient {v} is not a number; using 0.1"
+                )),
             }
         }
     }
@@ -467,8 +471,8 @@ impl Loader<'_> {
                     && p.yfov() < std::f32::consts::PI
                     && p.znear().is_finite()
                     && p.znear() > 0.0
-                    && p.zfar().is_none_or(|f| f.is_finite() && f > p.znear())
-                    && p.aspect_ratio().is_none_or(|a| a.is_finite() && a > 0.0);
+                    && p.zfar().map_or(true, |f| f.is_finite() && f > p.znear())
+                    && p.aspect_ratio().map_or(true, |a| a.is_finite() && a > 0.0);
                 let view = world.inverse();
                 if !ok || !view.is_finite() {
                     self.info.warn(format!(
@@ -633,8 +637,9 @@ impl Loader<'_> {
                 .warn("skinning and morph targets are not supported; drawn without them");
         }
 
-        let accessor_error =
-            |semantic: &str, index: usize| format!("{what}: {semantic} accessor {index} cannot be read (it lies outside its buffer or has no data)");
+        let accessor_error = |semantic: &str, index: usize| {
+            format!("{what}: {semantic} accessor {index} cannot be read (it lies outside its buffer or has no data)")
+        };
         let check = |semantic: &str,
                      accessor: &gltf::Accessor,
                      types: &[DataType],

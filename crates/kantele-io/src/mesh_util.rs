@@ -19,7 +19,7 @@ pub fn flat_normals(mesh: &mut Mesh) {
     if mesh.indices.len() % 3 != 0 || mesh.indices.iter().any(|&i| i as usize >= n) {
         return;
     }
-    let attribute_ok = |len: Option<usize>| len.is_none_or(|l| l == n);
+    let attribute_ok = |len: Option<usize>| len.map_or(true, |l| l == n);
     if !attribute_ok(mesh.texcoords.as_ref().map(Vec::len))
         || !attribute_ok(mesh.colors.as_ref().map(Vec::len))
     {

@@ -38,7 +38,10 @@ fn unknown_extension() {
     let dir = temp_dir("unknown");
     let path = dir.join("scene.txt");
     std::fs::write(&path, b"hello").unwrap();
-    assert!(matches!(load_scene(&path), Err(LoadError::UnknownFormat { .. })));
+    assert!(matches!(
+        load_scene(&path),
+        Err(LoadError::UnknownFormat { .. })
+    ));
     expect_error(&path, "unknown scene format");
 }
 
@@ -97,7 +100,16 @@ fn truncated_glb() {
     textured_quad().write_glb(&full);
     let bytes = std::fs::read(&full).unwrap();
     assert!(load_scene(&full).is_ok());
-    for cut in [4, 11, 12, 19, 20, bytes.len() / 2, bytes.len() - 40, bytes.len() - 1] {
+    for cut in [
+        4,
+        11,
+        12,
+        19,
+        20,
+        bytes.len() / 2,
+        bytes.len() - 40,
+        bytes.len() - 1,
+    ] {
         let path = dir.join(format!("cut{cut}.glb"));
         std::fs::write(&path, &bytes[..cut]).unwrap();
         expect_error(&path, "");
@@ -116,7 +128,10 @@ fn index_out_of_range() {
     let mut g = Gltf::new();
     let p = g.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
     let i = g.indices_u16(&[0, 1, 2, 0, 2, 7]);
-    let mesh = g.mesh("bad", vec![json!({"attributes": {"POSITION": p}, "indices": i})]);
+    let mesh = g.mesh(
+        "bad",
+        vec![json!({"attributes": {"POSITION": p}, "indices": i})],
+    );
     let n = g.node(json!({"mesh": mesh}));
     g.root(n);
     let dir = temp_dir("range");
@@ -146,7 +161,10 @@ fn wrong_attribute_types() {
     let p = g.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
     // COLOR_0 as VEC2 is not allowed (the gltf crate's reader would hit `unreachable!`).
     let c = g.vec2(&[[0.0, 0.0]; 3]);
-    let mesh = g.mesh("bad", vec![json!({"attributes": {"POSITION": p, "COLOR_0": c}})]);
+    let mesh = g.mesh(
+        "bad",
+        vec![json!({"attributes": {"POSITION": p, "COLOR_0": c}})],
+    );
     let n = g.node(json!({"mesh": mesh}));
     g.root(n);
     let dir = temp_dir("types");
@@ -174,9 +192,17 @@ fn node_cycles_do_not_hang() {
 #[test]
 fn nan_positions_load() {
     let mut g = Gltf::new();
-    let p = g.vec3(&[[0.0, 0.0, 0.0], [f32::NAN, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]);
+    let p = g.vec3(&[
+        [0.0, 0.0, 0.0],
+        [f32::NAN, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+    ]);
     let i = g.indices_u16(&[0, 1, 2, 0, 3, 2]);
-    let mesh = g.mesh("nan", vec![json!({"attributes": {"POSITION": p}, "indices": i})]);
+    let mesh = g.mesh(
+        "nan",
+        vec![json!({"attributes": {"POSITION": p}, "indices": i})],
+    );
     let n = g.node(json!({"mesh": mesh}));
     g.root(n);
     let dir = temp_dir("nan");
@@ -238,7 +264,8 @@ fn bad_data_uri() {
     let g = textured_quad();
     let path = dir.join("baduri.gltf");
     g.write_gltf_embedded(&path);
-    let mut json: serde_json::Value = serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
     json["buffers"][0]["uri"] = json!("data:application/octet-stream;base64,!!!notbase64!!!");
     std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
     expect_error(&path, "base64");
@@ -259,8 +286,16 @@ fn broken_obj_files() {
     expect_error(&path, "");
     // A missing texture named by the MTL.
     let path = dir.join("tex.obj");
-    std::fs::write(&path, "mtllib tex.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n").unwrap();
-    std::fs::write(dir.join("tex.mtl"), "newmtl m\nKd 1 1 1\nmap_Kd nothere.png\n").unwrap();
+    std::fs::write(
+        &path,
+        "mtllib tex.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(
+        dir.join("tex.mtl"),
+        "newmtl m\nKd 1 1 1\nmap_Kd nothere.png\n",
+    )
+    .unwrap();
     let err = expect_error(&path, "nothere.png");
     assert!(err.contains("tex.obj"));
 }

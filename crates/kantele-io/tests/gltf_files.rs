@@ -61,7 +61,10 @@ fn glb_external_and_embedded_gltf_give_the_same_scene() {
     let c = load(&embedded);
     assert_same_scene(&a.scene, &b.scene);
     assert_same_scene(&a.scene, &c.scene);
-    assert_eq!(a.info.extensions_used, vec!["KHR_lights_punctual".to_string()]);
+    assert_eq!(
+        a.info.extensions_used,
+        vec!["KHR_lights_punctual".to_string()]
+    );
     assert!(a.info.warnings.is_empty(), "{:?}", a.info.warnings);
     assert_eq!(a.info.source, glb.display().to_string());
 }
@@ -107,7 +110,8 @@ fn the_quad_scene_follows_the_rules() {
     let draw = &scene.draws[0];
     assert_eq!(draw.node_name, "quad");
     assert_eq!(draw.node_index, 2);
-    let parent = Mat4::from_translation(Vec3::new(0.5, 0.0, 0.0)) * Mat4::from_scale(Vec3::splat(2.0));
+    let parent =
+        Mat4::from_translation(Vec3::new(0.5, 0.0, 0.0)) * Mat4::from_scale(Vec3::splat(2.0));
     let child = Mat4::from_translation(Vec3::new(0.0, 0.0, -1.0));
     assert!(draw.model.abs_diff_eq(parent * child, 1e-6));
 
@@ -142,7 +146,12 @@ fn the_quad_scene_follows_the_rules() {
 #[test]
 fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
     let mut g = Gltf::new();
-    let positions = g.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [1.0, 1.0, 0.0]]);
+    let positions = g.vec3(&[
+        [0.0, 0.0, 0.0],
+        [1.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 1.0, 0.0],
+    ]);
     // Normalized u16 texcoords and u8 RGBA colours.
     let texcoords = g.accessor(
         &[0u16, 0, 65535, 0, 0, 65535, 65535, 65535]
@@ -155,7 +164,9 @@ fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
         true,
     );
     let colors = g.accessor(
-        &[255u8, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0, 255, 255, 255, 255],
+        &[
+            255u8, 0, 0, 255, 0, 255, 0, 128, 0, 0, 255, 0, 255, 255, 255, 255,
+        ],
         UNSIGNED_BYTE,
         "VEC4",
         4,
@@ -205,7 +216,11 @@ fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
     assert!(scene.draws[2]
         .model
         .abs_diff_eq(Mat4::from_translation(Vec3::new(4.0, 0.0, 0.0)), 1e-6));
-    assert!(info.warnings.iter().any(|w| w.contains("Points")), "{:?}", info.warnings);
+    assert!(
+        info.warnings.iter().any(|w| w.contains("Points")),
+        "{:?}",
+        info.warnings
+    );
 
     // Default material appended once.
     assert_eq!(scene.materials.len(), 1);
@@ -226,7 +241,12 @@ fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
     // The strip became two counter-clockwise triangles.
     let strip = &scene.meshes[1];
     assert_eq!(strip.triangle_count(), 2);
-    assert!(strip.normals.as_ref().unwrap().iter().all(|n| *n == Vec3::Z));
+    assert!(strip
+        .normals
+        .as_ref()
+        .unwrap()
+        .iter()
+        .all(|n| *n == Vec3::Z));
 }
 
 #[test]
@@ -245,7 +265,8 @@ fn camera_and_light_come_from_the_first_nodes_in_draw_order() {
     let child = g.node(json!({"camera": cam0, "translation": [0.0, 0.0, 5.0], "extensions": {"KHR_lights_punctual": {"light": 0}}}));
     let o = g.node(json!({"camera": ortho}));
     let root0 = g.node(json!({"children": [o, child], "translation": [1.0, 0.0, 0.0]}));
-    let root1 = g.node(json!({"camera": cam1, "extensions": {"KHR_lights_punctual": {"light": 2}}}));
+    let root1 =
+        g.node(json!({"camera": cam1, "extensions": {"KHR_lights_punctual": {"light": 2}}}));
     let root2 = g.node(json!({"extensions": {"KHR_lights_punctual": {"light": 1}}}));
     g.root(root0);
     g.root(root1);
@@ -253,7 +274,10 @@ fn camera_and_light_come_from_the_first_nodes_in_draw_order() {
     // Something to draw, unlit.
     let p = g.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
     let mat = g.material(json!({"extensions": {"KHR_materials_unlit": {}}, "alphaMode": "BLEND"}));
-    let mesh = g.mesh("t", vec![json!({"attributes": {"POSITION": p}, "material": mat})]);
+    let mesh = g.mesh(
+        "t",
+        vec![json!({"attributes": {"POSITION": p}, "material": mat})],
+    );
     let n = g.node(json!({"mesh": mesh}));
     g.root(n);
     let dir = temp_dir("camera");
@@ -294,8 +318,15 @@ fn unsupported_extensions_warn_and_unreadable_required_ones_fail() {
     g.write_glb(&path);
     let loaded = load(&path);
     let w = &loaded.info.warnings;
-    assert!(w.iter().any(|w| w.contains("KHR_texture_transform")), "{w:?}");
-    assert!(w.iter().any(|w| w.contains("requires unsupported extension EXT_fancy")), "{w:?}");
+    assert!(
+        w.iter().any(|w| w.contains("KHR_texture_transform")),
+        "{w:?}"
+    );
+    assert!(
+        w.iter()
+            .any(|w| w.contains("requires unsupported extension EXT_fancy")),
+        "{w:?}"
+    );
     assert_eq!(w.iter().filter(|w| w.contains("EXT_fancy")).count(), 2);
     assert_eq!(loaded.info.extensions_used.len(), 3);
 
@@ -303,14 +334,21 @@ fn unsupported_extensions_warn_and_unreadable_required_ones_fail() {
     g.json["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
     let path = dir.join("draco.glb");
     g.write_glb(&path);
-    let err = load_scene(&path).expect_err("draco cannot be read").to_string();
-    assert!(err.contains("draco.glb") && err.contains("KHR_draco_mesh_compression"), "{err}");
+    let err = load_scene(&path)
+        .expect_err("draco cannot be read")
+        .to_string();
+    assert!(
+        err.contains("draco.glb") && err.contains("KHR_draco_mesh_compression"),
+        "{err}"
+    );
 }
 
 #[test]
 fn reference_scene_round_trips_through_gltf_with_external_files() {
     // A real file re-packed as .gltf + .bin with the image moved out gives the same scene.
-    let Some(dir) = reference_scenes() else { return };
+    let Some(dir) = reference_scenes() else {
+        return;
+    };
     let source = dir.join("thesis-cube-textured.glb");
     let bytes = std::fs::read(&source).expect("read");
     let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;

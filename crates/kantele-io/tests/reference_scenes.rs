@@ -1,4 +1,6 @@
 //! Every reference scene of `shared/scenes` loads with the counts of its INDEX.md.
+// Quaternions are copied digit for digit from the files.
+#![allow(clippy::excessive_precision)]
 
 mod common;
 
@@ -37,7 +39,9 @@ fn load(name: &str) -> Option<LoadedScene> {
 
 #[test]
 fn every_reference_scene_loads_with_its_index_counts() {
-    let Some(dir) = common::reference_scenes() else { return };
+    let Some(dir) = common::reference_scenes() else {
+        return;
+    };
     // Every .glb in the directory is in the table.
     let mut files: Vec<String> = std::fs::read_dir(&dir)
         .expect("read scenes")
@@ -81,21 +85,30 @@ fn every_reference_scene_loads_with_its_index_counts() {
 
 #[test]
 fn shared_meshes_are_not_duplicated() {
-    let Some(LoadedScene { scene, .. }) = load("thesis-t2-cubes.glb") else { return };
+    let Some(LoadedScene { scene, .. }) = load("thesis-t2-cubes.glb") else {
+        return;
+    };
     assert_eq!(scene.meshes.len(), 1);
     // The file's 24-vertex cube has no normals: flat normals de-index it to 36 vertices.
     assert_eq!(scene.meshes[0].positions.len(), 36);
     assert!(scene.draws.iter().all(|d| d.mesh == 0));
     // Draws are in node order.
-    assert!(scene.draws.windows(2).all(|w| w[0].node_index < w[1].node_index));
+    assert!(scene
+        .draws
+        .windows(2)
+        .all(|w| w[0].node_index < w[1].node_index));
 }
 
 #[test]
 fn lights() {
-    let Some(bunny) = load("bunny.glb") else { return };
+    let Some(bunny) = load("bunny.glb") else {
+        return;
+    };
     assert_eq!(bunny.scene.light, Light::Headlight);
     assert!(bunny.info.lights.is_empty());
-    let Some(teapot) = load("paper-c1-lowpoly-far.glb") else { return };
+    let Some(teapot) = load("paper-c1-lowpoly-far.glb") else {
+        return;
+    };
     assert_eq!(teapot.info.lights, vec!["sun".to_string()]);
     match teapot.scene.light {
         Light::Directional { to_light, color } => {
@@ -116,7 +129,9 @@ fn lights() {
 
 #[test]
 fn camera_view_is_the_inverse_of_the_camera_node() {
-    let Some(LoadedScene { scene, .. }) = load("thesis-cube-textured.glb") else { return };
+    let Some(LoadedScene { scene, .. }) = load("thesis-cube-textured.glb") else {
+        return;
+    };
     let node = Mat4::from_rotation_translation(
         Quat::from_xyzw(
             -0.19677872270423263,
@@ -141,7 +156,9 @@ fn camera_view_is_the_inverse_of_the_camera_node() {
 
 #[test]
 fn spot_is_textured_and_hangs_under_a_rotated_parent() {
-    let Some(LoadedScene { scene, info }) = load("spot-textured.glb") else { return };
+    let Some(LoadedScene { scene, info }) = load("spot-textured.glb") else {
+        return;
+    };
     assert_eq!(info.node_count, 4);
     assert_eq!(scene.textures.len(), 1);
     let texture = &scene.textures[0];
@@ -163,20 +180,29 @@ fn spot_is_textured_and_hangs_under_a_rotated_parent() {
         0.9659258262890683,
     ));
     let child = Mat4::IDENTITY;
-    assert!(draw.model.abs_diff_eq(parent * child, 1e-6), "{:?}", draw.model);
+    assert!(
+        draw.model.abs_diff_eq(parent * child, 1e-6),
+        "{:?}",
+        draw.model
+    );
     assert!(scene.meshes[0].texcoords.is_some());
 }
 
 #[test]
 fn alpha_blend_draws_blended_triangles_after_the_opaque_quad() {
-    let Some(LoadedScene { scene, .. }) = load("alpha-blend.glb") else { return };
+    let Some(LoadedScene { scene, .. }) = load("alpha-blend.glb") else {
+        return;
+    };
     let modes: Vec<AlphaMode> = scene
         .draws
         .iter()
         .map(|d| scene.materials[scene.meshes[d.mesh].material].alpha_mode)
         .collect();
     assert_eq!(modes[0], AlphaMode::Opaque);
-    assert!(modes[1..].iter().all(|m| *m == AlphaMode::Blend), "{modes:?}");
+    assert!(
+        modes[1..].iter().all(|m| *m == AlphaMode::Blend),
+        "{modes:?}"
+    );
     // Alpha from baseColorFactor, and one primitive with per-vertex alpha in COLOR_0.
     assert_eq!(scene.materials[1].base_color_factor.w, 0.5);
     let per_vertex_alpha = scene
@@ -191,7 +217,9 @@ fn alpha_blend_draws_blended_triangles_after_the_opaque_quad() {
 
 #[test]
 fn near_clip_ground_repeats_its_texture() {
-    let Some(LoadedScene { scene, .. }) = load("near-clip.glb") else { return };
+    let Some(LoadedScene { scene, .. }) = load("near-clip.glb") else {
+        return;
+    };
     let ground = &scene.meshes[scene.draws[0].mesh];
     let max_uv = ground
         .texcoords

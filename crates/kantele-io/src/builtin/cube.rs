@@ -156,13 +156,19 @@ mod tests {
         for p in &mesh.positions {
             let clip = clip_from_world * model.transform_point3(*p).extend(1.0);
             let ndc = clip.truncate() / clip.w;
-            assert!(clip.w > 0.0 && ndc.abs().max_element() < 1.0, "{p} out of view");
+            assert!(
+                clip.w > 0.0 && ndc.abs().max_element() < 1.0,
+                "{p} out of view"
+            );
         }
         // Front, right and top faces are visible (counter-clockwise in NDC), the others culled.
         let mut front_facing = 0;
         for tri in mesh.indices.chunks_exact(3) {
             let [a, b, c] = [0, 1, 2].map(|k| {
-                let clip = clip_from_world * model.transform_point3(mesh.positions[tri[k] as usize]).extend(1.0);
+                let clip = clip_from_world
+                    * model
+                        .transform_point3(mesh.positions[tri[k] as usize])
+                        .extend(1.0);
                 clip.truncate().truncate() / clip.w
             });
             if (b - a).perp_dot(c - a) > 0.0 {

@@ -102,8 +102,7 @@ pub fn scene() -> (Scene, SceneInfo) {
             draw(0, Mat4::IDENTITY, "ground", 2),
             draw(
                 1,
-                Mat4::from_translation(Vec3::new(-1.2, 0.5, -5.0))
-                    * Mat4::from_rotation_y(0.6),
+                Mat4::from_translation(Vec3::new(-1.2, 0.5, -5.0)) * Mat4::from_rotation_y(0.6),
                 "cube",
                 3,
             ),

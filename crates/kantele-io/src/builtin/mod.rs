@@ -64,7 +64,11 @@ mod tests {
             assert!(loaded.info.camera_from_file);
             assert_eq!(loaded.scene.clear_color, CLEAR_COLOR);
             for mesh in &loaded.scene.meshes {
-                assert!(mesh.normals.is_some(), "{name}: mesh {} lacks normals", mesh.name);
+                assert!(
+                    mesh.normals.is_some(),
+                    "{name}: mesh {} lacks normals",
+                    mesh.name
+                );
             }
         }
         assert!(build("nope").is_none());

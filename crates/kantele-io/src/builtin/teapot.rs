@@ -35,7 +35,9 @@ fn y_up(p: Vec3) -> Vec3 {
 
 /// The 16 control points of a patch, `[row along u][column along v]`, y up.
 fn control_points(patch: &[u16; 16]) -> [[Vec3; 4]; 4] {
-    std::array::from_fn(|i| std::array::from_fn(|j| y_up(Vec3::from(POINTS[patch[4 * i + j] as usize - 1]))))
+    std::array::from_fn(|i| {
+        std::array::from_fn(|j| y_up(Vec3::from(POINTS[patch[4 * i + j] as usize - 1])))
+    })
 }
 
 /// Position and partial derivatives `(P, ∂P/∂u, ∂P/∂v)` of a patch at `(u, v)`.
@@ -162,7 +164,10 @@ mod tests {
             .all(|&i| (1..=306).contains(&(i as usize))));
         // The teapot is symmetric about the classic xz plane.
         for p in POINTS {
-            assert!(POINTS.contains(&[p[0], -p[1], p[2]]) || p[1] == 0.0, "{p:?}");
+            assert!(
+                POINTS.contains(&[p[0], -p[1], p[2]]) || p[1] == 0.0,
+                "{p:?}"
+            );
         }
     }
 
@@ -174,7 +179,10 @@ mod tests {
         // Eight patches (lid top, bottom) have a pole: n triangles collapse in each.
         assert_eq!(mesh.triangle_count(), 32 * n * n * 2 - 8 * n);
         let (lo, hi) = mesh.bounds().unwrap();
-        assert!((lo.y - 0.0).abs() < 1e-4 && (hi.y - 3.15).abs() < 1e-4, "{lo} {hi}");
+        assert!(
+            (lo.y - 0.0).abs() < 1e-4 && (hi.y - 3.15).abs() < 1e-4,
+            "{lo} {hi}"
+        );
         assert!(hi.x > 3.0 && lo.x < -2.9);
     }
 

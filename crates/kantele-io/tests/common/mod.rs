@@ -25,10 +25,7 @@ pub fn reference_scenes() -> Option<PathBuf> {
     if dir.is_dir() {
         Some(dir)
     } else {
-        eprintln!(
-            "reference scenes not found at {}; skipping",
-            dir.display()
-        );
+        eprintln!("reference scenes not found at {}; skipping", dir.display());
         None
     }
 }
@@ -59,7 +56,11 @@ pub fn base64(data: &[u8]) -> String {
     const ALPHABET: &[u8] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut out = String::new();
     for chunk in data.chunks(3) {
-        let b = [chunk[0], *chunk.get(1).unwrap_or(&0), *chunk.get(2).unwrap_or(&0)];
+        let b = [
+            chunk[0],
+            *chunk.get(1).unwrap_or(&0),
+            *chunk.get(2).unwrap_or(&0),
+        ];
         let n = (b[0] as u32) << 16 | (b[1] as u32) << 8 | b[2] as u32;
         for k in 0..4 {
             if k <= chunk.len() {
@@ -152,7 +153,11 @@ impl Gltf {
     }
 
     pub fn vec3(&mut self, values: &[[f32; 3]]) -> usize {
-        let bytes: Vec<u8> = values.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+        let bytes: Vec<u8> = values
+            .iter()
+            .flatten()
+            .flat_map(|f| f.to_le_bytes())
+            .collect();
         let idx = self.accessor(&bytes, FLOAT, "VEC3", values.len(), false);
         let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
         for v in values {
@@ -169,7 +174,11 @@ impl Gltf {
     }
 
     pub fn vec2(&mut self, values: &[[f32; 2]]) -> usize {
-        let bytes: Vec<u8> = values.iter().flatten().flat_map(|f| f.to_le_bytes()).collect();
+        let bytes: Vec<u8> = values
+            .iter()
+            .flatten()
+            .flat_map(|f| f.to_le_bytes())
+            .collect();
         self.accessor(&bytes, FLOAT, "VEC2", values.len(), false)
     }
 
@@ -220,7 +229,10 @@ impl Gltf {
     /// An image whose bytes go into the buffer (`.glb`) or a file / data URI (`.gltf`).
     pub fn image(&mut self, bytes: Vec<u8>) -> usize {
         self.images.push(bytes);
-        self.push("images", json!({"name": format!("image{}", self.images.len() - 1)}))
+        self.push(
+            "images",
+            json!({"name": format!("image{}", self.images.len() - 1)}),
+        )
     }
 
     fn finished_json(&self, buffer_uri: Option<String>) -> Value {
@@ -310,7 +322,8 @@ pub fn textured_quad() -> Gltf {
     let texcoords = g.vec2(&[[0.0, 1.0], [1.0, 1.0], [1.0, 0.0], [0.0, 0.0]]);
     let indices = g.indices_u16(&[0, 1, 2, 0, 2, 3]);
     let image = g.image(test_png());
-    let sampler = g.sampler(json!({"magFilter": 9728, "minFilter": 9986, "wrapS": 33071, "wrapT": 33648}));
+    let sampler =
+        g.sampler(json!({"magFilter": 9728, "minFilter": 9986, "wrapS": 33071, "wrapT": 33648}));
     let texture = g.texture(json!({"source": image, "sampler": sampler}));
     let material = g.material(json!({
         "name": "quad-material",
@@ -327,8 +340,11 @@ pub fn textured_quad() -> Gltf {
             "material": material,
         })],
     );
-    let camera = g.camera(json!({"name": "cam", "type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}));
-    let camera_node = g.node(json!({"name": "camera", "camera": camera, "translation": [0.0, 0.0, 2.0]}));
+    let camera = g.camera(
+        json!({"name": "cam", "type": "perspective", "perspective": {"yfov": 0.8, "znear": 0.1}}),
+    );
+    let camera_node =
+        g.node(json!({"name": "camera", "camera": camera, "translation": [0.0, 0.0, 2.0]}));
     g.root(camera_node);
     g.json["extensionsUsed"] = json!(["KHR_lights_punctual"]);
     g.json["extensions"] = json!({"KHR_lights_punctual": {"lights": [
@@ -341,6 +357,7 @@ pub fn textured_quad() -> Gltf {
     let child = g.node(json!({"name": "quad", "mesh": mesh, "translation": [0.0, 0.0, -1.0]}));
     let parent = g.node(json!({"name": "parent", "translation": [0.5, 0.0, 0.0], "scale": [2.0, 2.0, 2.0], "children": [child]}));
     g.root(parent);
-    g.json["scenes"][0]["extras"] = json!({"resolution": [320, 240], "clear_color": [0.1, 0.2, 0.3, 1.0], "ambient": 0.25});
+    g.json["scenes"][0]["extras"] =
+        json!({"resolution": [320, 240], "clear_color": [0.1, 0.2, 0.3, 1.0], "ambient": 0.25});
     g
 }
