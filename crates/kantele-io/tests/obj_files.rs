@@ -1,0 +1,116 @@
+//! OBJ + MTL files written by the tests.
+
+mod common;
+
+use common::*;
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use kantele::scene::{AlphaMode, Light};
+use kantele::shade::texture::{MinFilter, Wrap};
+use kantele_io::load_scene;
+
+const CUBE_OBJ_WITH_NORMALS: &str = "\
+mtllib things.mtl
+o quad
+v -1 -1 0
+v 1 -1 0
+v 1 1 0
+v -1 1 0
+vt 0 0
+vt 1 0
+vt 1 1
+vt 0 1
+vn 0 0 1
+usemtl textured
+f 1/1/1 2/2/1 3/3/1 4/4/1
+o tri
+v 0 0 1
+v 1 0 1
+v 0 1 1
+usemtl glass
+f 5 6 7
+";
+
+const MTL: &str = "\
+newmtl textured
+Kd 0.5 0.25 1.0
+map_Kd checker.png
+
+newmtl glass
+Kd 0.2 0.4 0.6
+d 0.25
+";
+
+#[test]
+fn obj_with_mtl_texture_normals_and_without() {
+    let dir = temp_dir("obj");
+    std::fs::write(dir.join("things.obj"), CUBE_OBJ_WITH_NORMALS).unwrap();
+    std::fs::write(dir.join("things.mtl"), MTL).unwrap();
+    std::fs::write(dir.join("checker.png"), test_png()).unwrap();
+    let path = dir.join("things.obj");
+    let loaded = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    let (scene, info) = (&loaded.scene, &loaded.info);
+    assert!(info.warnings.is_empty(), "{:?}", info.warnings);
+    assert!(!info.camera_from_file);
+    assert_eq!(scene.light, Light::Headlight);
+    assert_eq!(scene.resolution, (800, 600));
+    assert_eq!(scene.draws.len(), 2);
+    assert_eq!(scene.triangle_count(), 3);
+    assert!(scene.draws.iter().all(|d| d.model == Mat4::IDENTITY));
+    assert_eq!(scene.draws[0].node_name, "quad");
+    assert_eq!(scene.draws[1].node_index, 1);
+
+    // The quad: smooth normals from the file, v flipped.
+    let quad = &scene.meshes[scene.draws[0].mesh];
+    assert_eq!(quad.positions.len(), 4);
+    assert_eq!(quad.triangle_count(), 2);
+    assert!(quad.normals.as_ref().unwrap().iter().all(|n| *n == Vec3::Z));
+    let uv = quad.texcoords.as_ref().unwrap();
+    let at = |p: Vec3| uv[quad.positions.iter().position(|q| *q == p).unwrap()];
+    assert_eq!(at(Vec3::new(-1.0, -1.0, 0.0)), Vec2::new(0.0, 1.0));
+    assert_eq!(at(Vec3::new(1.0, 1.0, 0.0)), Vec2::new(1.0, 0.0));
+    let material = &scene.materials[quad.material];
+    assert_eq!(material.name, "textured");
+    assert_eq!(material.base_color_factor, Vec4::new(0.5, 0.25, 1.0, 1.0));
+    assert_eq!(material.alpha_mode, AlphaMode::Opaque);
+    let binding = material.base_color_texture.expect("map_Kd");
+    assert_eq!(binding.sampler.wrap_s, Wrap::Repeat);
+    assert_eq!(binding.sampler.min_filter, MinFilter::LinearMipmapLinear);
+    assert_eq!(scene.textures[binding.texture].width(), 2);
+
+    // The triangle: no normals in the file → flat, de-indexed; dissolve → blend.
+    let tri = &scene.meshes[scene.draws[1].mesh];
+    assert_eq!(tri.positions.len(), 3);
+    assert!(tri.normals.as_ref().unwrap().iter().all(|n| *n == Vec3::Z));
+    assert!(tri.texcoords.is_none());
+    let glass = &scene.materials[tri.material];
+    assert_eq!(glass.alpha_mode, AlphaMode::Blend);
+    assert_eq!(glass.base_color_factor, Vec4::new(0.2, 0.4, 0.6, 0.25));
+
+    // The framing camera looks at the scene.
+    let (center, _) = scene.bounding_sphere().unwrap();
+    assert!(scene.camera.view.transform_point3(center).z < 0.0);
+}
+
+#[test]
+fn obj_without_mtl_uses_the_default_material() {
+    let dir = temp_dir("obj-nomtl");
+    let path = dir.join("lonely.obj");
+    std::fs::write(
+        &path,
+        "mtllib gone.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nusemtl x\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let loaded = load_scene(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert!(
+        loaded.info.warnings.iter().any(|w| w.contains("material")),
+        "{:?}",
+        loaded.info.warnings
+    );
+    let scene = &loaded.scene;
+    assert_eq!(scene.materials, vec![kantele::scene::Material::default()]);
+    assert_eq!(scene.triangle_count(), 2);
+    let mesh = &scene.meshes[0];
+    // Flat normals: 6 vertices, all +z.
+    assert_eq!(mesh.positions.len(), 6);
+    assert!(mesh.normals.as_ref().unwrap().iter().all(|n| *n == Vec3::Z));
+}
