@@ -5,6 +5,7 @@
 pub mod backend;
 pub mod camera;
 pub mod color;
+pub mod compare;
 pub mod demo;
 pub mod cpu;
 pub mod error;
