@@ -31,7 +31,13 @@ fn render_both(path: &Path, gl: &mut GlBackend) -> (FrameImage, FrameImage, Fram
     let view = FrameView::of_scene(&scene);
     let a = render(&mut cpu, &view);
     let b = render(gl, &view);
-    let ids = render(&mut cpu, &FrameView { pass: Pass::Ids, ..view });
+    let ids = render(
+        &mut cpu,
+        &FrameView {
+            pass: Pass::Ids,
+            ..view
+        },
+    );
     (a, b, ids)
 }
 
@@ -60,10 +66,14 @@ fn every_reference_scene_agrees_with_opengl() {
     assert!(!paths.is_empty());
     let mut failures = Vec::new();
     for path in &paths {
-        let name = path.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_default();
+        let name = path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default();
         let (cpu, gl_image, ids) = render_both(path, &mut gl);
         let edges = edge_mask(&ids);
-        let c: Comparison = compare(&cpu, &gl_image, Some(&edges), INTERIOR_BOUND).expect("same size");
+        let c: Comparison =
+            compare(&cpu, &gl_image, Some(&edges), INTERIOR_BOUND).expect("same size");
         let textured = name.contains("textured") || name == "near-clip";
         eprintln!(
             "{name:28} coverage {:.4}%  mean {:.3}  max {:3}  interior>{INTERIOR_BOUND}: {:6} ({:.3}%)  depth max {:.2e}",
@@ -85,7 +95,11 @@ fn every_reference_scene_agrees_with_opengl() {
         // Texture level-of-detail choices differ between drivers (the scenes' README measures
         // up to 0.6% of pixels between llvmpipe and NVIDIA); untextured scenes must agree
         // everywhere but on edges.
-        let allowed = if textured { c.pixels / 100 } else { c.pixels / 2000 };
+        let allowed = if textured {
+            c.pixels / 100
+        } else {
+            c.pixels / 2000
+        };
         if c.interior_over_bound > allowed {
             problems.push("interior colour");
         }
@@ -104,10 +118,14 @@ fn every_reference_scene_agrees_with_opengl() {
                 ("difference", c.difference_image.clone()),
             ] {
                 let file = out.join(format!("{name}-{suffix}.png"));
-                image::save_buffer(&file, &data, cpu.width, cpu.height, image::ColorType::Rgba8).expect("write");
+                image::save_buffer(&file, &data, cpu.width, cpu.height, image::ColorType::Rgba8)
+                    .expect("write");
             }
             failures.push(format!("{name}: {}", problems.join(", ")));
         }
     }
-    assert!(failures.is_empty(), "disagreements (images in target/test-output): {failures:#?}");
+    assert!(
+        failures.is_empty(),
+        "disagreements (images in target/test-output): {failures:#?}"
+    );
 }

@@ -471,8 +471,8 @@ impl Loader<'_> {
                     && p.yfov() < std::f32::consts::PI
                     && p.znear().is_finite()
                     && p.znear() > 0.0
-                    && p.zfar().map_or(true, |f| f.is_finite() && f > p.znear())
-                    && p.aspect_ratio().map_or(true, |a| a.is_finite() && a > 0.0);
+                    && p.zfar().is_none_or(|f| f.is_finite() && f > p.znear())
+                    && p.aspect_ratio().is_none_or(|a| a.is_finite() && a > 0.0);
                 let view = world.inverse();
                 if !ok || !view.is_finite() {
                     self.info.warn(format!(

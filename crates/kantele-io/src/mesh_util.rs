@@ -19,34 +19,13 @@ pub fn flat_normals(mesh: &mut Mesh) {
     if mesh.indices.len() % 3 != 0 || mesh.indices.iter().any(|&i| i as usize >= n) {
         return;
     }
-    let attribute_ok = |len: Option<usize>| len.map_or(true, |l| l == n);
+    let attribute_ok = |len: Option<usize>| len.is_none_or(|l| l == n);
     if !attribute_ok(mesh.texcoords.as_ref().map(Vec::len))
         || !attribute_ok(mesh.colors.as_ref().map(Vec::len))
     {
         return;
     }
-    let count = mesh.indices.len();
-    let mut positions = Vec::with_capacity(count);
-    let mut normals = Vec::with_capacity(count);
-    for tri in mesh.indices.chunks_exact(3) {
-        let [a, b, c] = [0, 1, 2].map(|k| mesh.positions[tri[k] as usize]);
-        let normal = (b - a).cross(c - a).try_normalize().unwrap_or(Vec3::Z);
-        positions.extend([a, b, c]);
-        normals.extend([normal; 3]);
-    }
-    let gather = |values: &Vec<_>| mesh.indices.iter().map(|&i| values[i as usize]).collect();
-    let texcoords = mesh.texcoords.as_ref().map(gather);
-    let colors = mesh.colors.as_ref().map(|values| {
-        mesh.indices
-            .iter()
-            .map(|&i| values[i as usize])
-            .collect::<Vec<_>>()
-    });
-    mesh.positions = positions;
-    mesh.normals = Some(normals);
-    mesh.texcoords = texcoords;
-    mesh.colors = colors;
-    mesh.indices = (0..count as u32).collect();
+    *mesh = mesh.flat_shaded();
 }
 
 /// Converts a triangle strip (`TRIANGLE_STRIP`) to a triangle list, as glTF defines it: triangle

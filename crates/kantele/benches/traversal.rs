@@ -22,7 +22,14 @@ fn triangles(count: usize, size: f32, aspect: f32) -> Vec<TriangleSetup> {
         seed ^= seed << 17;
         (seed % 1_000_000) as f32 / 1_000_000.0
     };
-    let to_ndc = |x: f32, y: f32| Vec4::new(x / WIDTH as f32 * 2.0 - 1.0, 1.0 - y / HEIGHT as f32 * 2.0, 0.0, 1.0);
+    let to_ndc = |x: f32, y: f32| {
+        Vec4::new(
+            x / WIDTH as f32 * 2.0 - 1.0,
+            1.0 - y / HEIGHT as f32 * 2.0,
+            0.0,
+            1.0,
+        )
+    };
     (0..count)
         .filter_map(|_| {
             let x = rand() * (WIDTH as f32 - size * aspect);
@@ -50,24 +57,35 @@ fn bench_traversal(c: &mut Criterion) {
         let mut pixels = 0u64;
         for (tile, bin) in bins.bins.iter().enumerate() {
             for &t in bin {
-                rasterize(&tris[t as usize], grid.tile_rect(tile), Strategy::BoundingBox, |_, _| pixels += 1);
+                rasterize(
+                    &tris[t as usize],
+                    grid.tile_rect(tile),
+                    Strategy::BoundingBox,
+                    |_, _| pixels += 1,
+                );
             }
         }
         let mut group = c.benchmark_group(format!("traversal/{name}"));
         group.throughput(Throughput::Elements(pixels));
         for strategy in Strategy::ALL {
-            group.bench_with_input(BenchmarkId::from_parameter(strategy), &strategy, |b, &strategy| {
-                b.iter(|| {
-                    let mut covered = 0u64;
-                    for (tile, bin) in bins.bins.iter().enumerate() {
-                        let rect = grid.tile_rect(tile);
-                        for &t in bin {
-                            rasterize(&tris[t as usize], rect, strategy, |x, _| covered += x as u64 & 1 | 1);
+            group.bench_with_input(
+                BenchmarkId::from_parameter(strategy),
+                &strategy,
+                |b, &strategy| {
+                    b.iter(|| {
+                        let mut covered = 0u64;
+                        for (tile, bin) in bins.bins.iter().enumerate() {
+                            let rect = grid.tile_rect(tile);
+                            for &t in bin {
+                                rasterize(&tris[t as usize], rect, strategy, |x, _| {
+                                    covered += x as u64 & 1 | 1
+                                });
+                            }
                         }
-                    }
-                    black_box(covered)
-                })
-            });
+                        black_box(covered)
+                    })
+                },
+            );
         }
         group.finish();
     }

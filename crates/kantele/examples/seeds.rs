@@ -8,14 +8,28 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     std::fs::create_dir_all(&out)?;
     let mut renderer = Renderer::new(800, 600, RendererOptions::default())?;
     for (name, render) in [
-        ("thesis-cube", kantele::demo::render_thesis_cube as fn(&mut Renderer) -> _),
+        (
+            "thesis-cube",
+            kantele::demo::render_thesis_cube as fn(&mut Renderer) -> _,
+        ),
         ("exercise", kantele::demo::render_exercise),
     ] {
         let stats = render(&mut renderer)?;
         let fb = renderer.framebuffer();
         let path = out.join(format!("{name}.png"));
-        image::save_buffer(&path, &fb.read_rgba8(true), fb.width(), fb.height(), image::ColorType::Rgba8)?;
-        println!("{}: {} triangles, {:.2} ms", path.display(), stats.triangles_binned, stats.total_time.as_secs_f64() * 1e3);
+        image::save_buffer(
+            &path,
+            &fb.read_rgba8(true),
+            fb.width(),
+            fb.height(),
+            image::ColorType::Rgba8,
+        )?;
+        println!(
+            "{}: {} triangles, {:.2} ms",
+            path.display(),
+            stats.triangles_binned,
+            stats.total_time.as_secs_f64() * 1e3
+        );
     }
     Ok(())
 }

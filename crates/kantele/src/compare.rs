@@ -36,7 +36,12 @@ impl Comparison {
 /// Compares frames `a` and `b` of equal size. `edges`, if given, marks pixels on triangle edges
 /// (see [`edge_mask`]); they are excluded from `interior_over_bound`, which counts pixels whose
 /// colour differs by more than `bound` levels.
-pub fn compare(a: &FrameImage, b: &FrameImage, edges: Option<&[bool]>, bound: u8) -> Option<Comparison> {
+pub fn compare(
+    a: &FrameImage,
+    b: &FrameImage,
+    edges: Option<&[bool]>,
+    bound: u8,
+) -> Option<Comparison> {
     if a.width != b.width || a.height != b.height || a.color.len() != b.color.len() {
         return None;
     }
@@ -131,7 +136,14 @@ mod tests {
     fn identical_frames_agree_and_differences_are_measured() {
         let a = frame([0.5, 0.5, 0.5, 1.0], 0.5);
         let same = compare(&a, &a, None, 0).expect("same size");
-        assert_eq!((same.max_color_diff, same.coverage_mismatches, same.interior_over_bound), (0, 0, 0));
+        assert_eq!(
+            (
+                same.max_color_diff,
+                same.coverage_mismatches,
+                same.interior_over_bound
+            ),
+            (0, 0, 0)
+        );
         let mut b = a.clone();
         b.color[0] = [1.0, 0.5, 0.5, 1.0];
         b.depth[3] = 1.0;
@@ -140,8 +152,22 @@ mod tests {
         assert_eq!(diff.coverage_mismatches, 1);
         assert_eq!(diff.interior_over_bound, 1);
         let edges = [true, false, false, false];
-        assert_eq!(compare(&a, &b, Some(&edges), 3).expect("same").interior_over_bound, 0);
-        assert!(compare(&a, &FrameImage { width: 1, ..a.clone() }, None, 0).is_none());
+        assert_eq!(
+            compare(&a, &b, Some(&edges), 3)
+                .expect("same")
+                .interior_over_bound,
+            0
+        );
+        assert!(compare(
+            &a,
+            &FrameImage {
+                width: 1,
+                ..a.clone()
+            },
+            None,
+            0
+        )
+        .is_none());
     }
 
     #[test]

@@ -24,12 +24,21 @@ use crate::shade::texture::{ColorSpace, MinFilter, Sampler, Texture, Wrap};
 use crate::stats::FrameStats;
 
 /// A `size × size` sRGB checker texture with `squares × squares` squares of two colours.
-pub fn checker_texture(size: u32, squares: u32, a: [u8; 3], b: [u8; 3]) -> Result<Texture, RenderError> {
+pub fn checker_texture(
+    size: u32,
+    squares: u32,
+    a: [u8; 3],
+    b: [u8; 3],
+) -> Result<Texture, RenderError> {
     let cell = (size / squares.max(1)).max(1);
     let mut rgba = Vec::with_capacity((size * size * 4) as usize);
     for y in 0..size {
         for x in 0..size {
-            let c = if ((x / cell) + (y / cell)) % 2 == 0 { a } else { b };
+            let c = if ((x / cell) + (y / cell)) % 2 == 0 {
+                a
+            } else {
+                b
+            };
             rgba.extend_from_slice(&[c[0], c[1], c[2], 255]);
         }
     }
@@ -51,12 +60,30 @@ pub struct CubeVertex {
 /// outside. (The listing repeats one triangle of the bottom face; the intended face is used.)
 pub fn thesis_cube() -> (Vec<CubeVertex>, Vec<u16>) {
     let p = [
-        [-0.5, 0.5, 0.5], [-0.5, -0.5, 0.5], [0.5, -0.5, 0.5], [0.5, 0.5, 0.5], // front
-        [0.5, 0.5, 0.5], [0.5, -0.5, 0.5], [0.5, -0.5, -0.5], [0.5, 0.5, -0.5], // right
-        [0.5, 0.5, -0.5], [0.5, -0.5, -0.5], [-0.5, -0.5, -0.5], [-0.5, 0.5, -0.5], // back
-        [-0.5, 0.5, -0.5], [-0.5, -0.5, -0.5], [-0.5, -0.5, 0.5], [-0.5, 0.5, 0.5], // left
-        [-0.5, 0.5, -0.5], [-0.5, 0.5, 0.5], [0.5, 0.5, 0.5], [0.5, 0.5, -0.5], // top
-        [-0.5, -0.5, 0.5], [-0.5, -0.5, -0.5], [0.5, -0.5, -0.5], [0.5, -0.5, 0.5], // bottom
+        [-0.5, 0.5, 0.5],
+        [-0.5, -0.5, 0.5],
+        [0.5, -0.5, 0.5],
+        [0.5, 0.5, 0.5], // front
+        [0.5, 0.5, 0.5],
+        [0.5, -0.5, 0.5],
+        [0.5, -0.5, -0.5],
+        [0.5, 0.5, -0.5], // right
+        [0.5, 0.5, -0.5],
+        [0.5, -0.5, -0.5],
+        [-0.5, -0.5, -0.5],
+        [-0.5, 0.5, -0.5], // back
+        [-0.5, 0.5, -0.5],
+        [-0.5, -0.5, -0.5],
+        [-0.5, -0.5, 0.5],
+        [-0.5, 0.5, 0.5], // left
+        [-0.5, 0.5, -0.5],
+        [-0.5, 0.5, 0.5],
+        [0.5, 0.5, 0.5],
+        [0.5, 0.5, -0.5], // top
+        [-0.5, -0.5, 0.5],
+        [-0.5, -0.5, -0.5],
+        [0.5, -0.5, -0.5],
+        [0.5, -0.5, 0.5], // bottom
     ];
     let uv = [[0.0, 0.0], [0.0, 1.0], [1.0, 1.0], [1.0, 0.0]];
     let vertices = p
@@ -115,7 +142,12 @@ pub fn render_thesis_cube(renderer: &mut Renderer) -> Result<FrameStats, RenderE
     );
     let (vertices, indices) = thesis_cube();
     let mut frame = renderer.begin_frame(Some(Vec4::new(0.02, 0.02, 0.05, 1.0)), Some(1.0));
-    frame.draw(&shader, &vertices, Indices::U16(&indices), RenderState::default())?;
+    frame.draw(
+        &shader,
+        &vertices,
+        Indices::U16(&indices),
+        RenderState::default(),
+    )?;
     Ok(frame.end())
 }
 
@@ -135,7 +167,11 @@ pub fn uv_sphere(rings: u32, segments: u32) -> (Vec<LitVertex>, Vec<u32>) {
         let theta = r as f32 / rings as f32 * std::f32::consts::PI;
         for s in 0..=segments {
             let phi = s as f32 / segments as f32 * std::f32::consts::TAU;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.cos(), -theta.sin() * phi.sin());
+            let n = Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                -theta.sin() * phi.sin(),
+            );
             vertices.push(LitVertex { pos: n, normal: n });
         }
     }
@@ -212,9 +248,24 @@ pub fn render_exercise(renderer: &mut Renderer) -> Result<FrameStats, RenderErro
         ..RenderState::default()
     };
     let mut frame = renderer.begin_frame(Some(Vec4::new(0.05, 0.05, 0.08, 1.0)), Some(1.0));
-    frame.draw(&ground, &ground_vertices, Indices::U32(&ground_indices), RenderState::default())?;
+    frame.draw(
+        &ground,
+        &ground_vertices,
+        Indices::U32(&ground_indices),
+        RenderState::default(),
+    )?;
     // The farther sphere first, as the exercise sorts back to front.
-    frame.draw(&right, &sphere_vertices, Indices::U32(&sphere_indices), transparent)?;
-    frame.draw(&left, &sphere_vertices, Indices::U32(&sphere_indices), transparent)?;
+    frame.draw(
+        &right,
+        &sphere_vertices,
+        Indices::U32(&sphere_indices),
+        transparent,
+    )?;
+    frame.draw(
+        &left,
+        &sphere_vertices,
+        Indices::U32(&sphere_indices),
+        transparent,
+    )?;
     Ok(frame.end())
 }

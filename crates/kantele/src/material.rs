@@ -108,7 +108,12 @@ impl<'a> MaterialShader<'a> {
             let uv = Vec2::new(v[3], v[4]);
             let (du_dx, du_dy) = fragment.derivatives(3);
             let (dv_dx, dv_dy) = fragment.derivatives(4);
-            base *= texture.sample_grad(&sampler, uv, Vec2::new(du_dx, dv_dx), Vec2::new(du_dy, dv_dy));
+            base *= texture.sample_grad(
+                &sampler,
+                uv,
+                Vec2::new(du_dx, dv_dx),
+                Vec2::new(du_dy, dv_dy),
+            );
         }
         base
     }
@@ -177,7 +182,12 @@ impl MaterialShader<'_> {
     fn auxiliary(&self, fragment: &Fragment<'_>) -> Vec4 {
         match self.pass {
             Pass::Normals => self.normal(fragment).extend(1.0),
-            _ => Vec4::new(self.ids.0, fragment.primitive_id as f32 + 1.0, self.ids.1, 1.0),
+            _ => Vec4::new(
+                self.ids.0,
+                fragment.primitive_id as f32 + 1.0,
+                self.ids.1,
+                1.0,
+            ),
         }
     }
 }

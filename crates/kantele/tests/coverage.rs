@@ -107,7 +107,11 @@ fn jittered_grids_cover_every_pixel_of_the_square_exactly_once() {
             for x in 0..w {
                 let c = centre_ndc(x, y, w, h);
                 let inside = c.x.abs() < 0.5 && c.y.abs() < 0.5;
-                assert_eq!(counts[(y * w + x) as usize], inside as u32, "seed {seed} pixel ({x}, {y})");
+                assert_eq!(
+                    counts[(y * w + x) as usize],
+                    inside as u32,
+                    "seed {seed} pixel ({x}, {y})"
+                );
             }
         }
     }
@@ -263,8 +267,15 @@ fn every_strategy_and_thread_count_renders_the_same_image() {
         },
     );
     let render = |threads: usize, strategy: Strategy| {
-        let mut renderer =
-            Renderer::new(301, 203, RendererOptions { threads: Some(threads), strategy }).expect("renderer");
+        let mut renderer = Renderer::new(
+            301,
+            203,
+            RendererOptions {
+                threads: Some(threads),
+                strategy,
+            },
+        )
+        .expect("renderer");
         let mut frame = renderer.begin_frame(Some(Vec4::new(0.1, 0.2, 0.3, 1.0)), Some(1.0));
         let opaque = RenderState {
             cull: CullMode::None,
@@ -275,18 +286,31 @@ fn every_strategy_and_thread_count_renders_the_same_image() {
             depth_write: false,
             ..opaque
         };
-        frame.draw(&shader, &vertices, Indices::U32(&indices[..300]), opaque).expect("draw");
-        frame.draw(&shader, &vertices, Indices::U32(&indices[300..]), blended).expect("draw");
+        frame
+            .draw(&shader, &vertices, Indices::U32(&indices[..300]), opaque)
+            .expect("draw");
+        frame
+            .draw(&shader, &vertices, Indices::U32(&indices[300..]), blended)
+            .expect("draw");
         frame.end();
-        (renderer.framebuffer().read_color(), renderer.framebuffer().read_depth())
+        (
+            renderer.framebuffer().read_color(),
+            renderer.framebuffer().read_depth(),
+        )
     };
     let reference = render(1, Strategy::BoundingBox);
     let covered = reference.1.iter().filter(|d| **d < 1.0).count();
-    assert!(covered > 10_000, "scene should cover much of the target ({covered})");
+    assert!(
+        covered > 10_000,
+        "scene should cover much of the target ({covered})"
+    );
     for threads in [1, 2, 3, 8] {
         for strategy in Strategy::ALL {
             let image = render(threads, strategy);
-            assert!(image == reference, "{strategy} with {threads} threads differs");
+            assert!(
+                image == reference,
+                "{strategy} with {threads} threads differs"
+            );
         }
     }
 }

@@ -38,7 +38,9 @@ fn render(
 ) -> Renderer {
     let mut renderer = Renderer::new(size.0, size.1, RendererOptions::default()).expect("renderer");
     let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
-    frame.draw(shader, vertices, Indices::None, state).expect("draw");
+    frame
+        .draw(shader, vertices, Indices::None, state)
+        .expect("draw");
     frame.end();
     renderer
 }
@@ -57,7 +59,12 @@ fn pixel_ray(view_proj: Mat4, x: u32, y: u32, w: u32, h: u32) -> (Vec3, Vec3) {
 
 /// Ground plane y = 0 from (−s, −s) to (s, s) with texcoords = (x, z) / s mapped to [0, 1].
 fn ground(s: f32) -> Vec<Vtx> {
-    let v = |x: f32, z: f32| (Vec3::new(x, 0.0, z), Vec2::new((x / s + 1.0) * 0.5, (z / s + 1.0) * 0.5));
+    let v = |x: f32, z: f32| {
+        (
+            Vec3::new(x, 0.0, z),
+            Vec2::new((x / s + 1.0) * 0.5, (z / s + 1.0) * 0.5),
+        )
+    };
     vec![v(-s, -s), v(-s, s), v(s, s), v(-s, -s), v(s, s), v(s, -s)]
 }
 
@@ -99,7 +106,11 @@ fn a_triangle_reaching_behind_the_eye_renders_its_visible_part() {
     // visible part must be exactly the pixels whose ray hits the plane in front of the camera.
     let (w, h) = (128, 96);
     let view_proj = perspective(1.2, w as f32 / h as f32, 0.1, 1000.0)
-        * look_at(Vec3::new(0.0, 1.5, 0.0), Vec3::new(0.0, 1.5, -10.0), Vec3::Y);
+        * look_at(
+            Vec3::new(0.0, 1.5, 0.0),
+            Vec3::new(0.0, 1.5, -10.0),
+            Vec3::Y,
+        );
     let s = 500.0;
     let renderer = render((w, h), &attribute_shader(view_proj), &ground(s), no_cull());
     let fb = renderer.framebuffer();
@@ -110,7 +121,9 @@ fn a_triangle_reaching_behind_the_eye_renders_its_visible_part() {
             let (origin, dir) = pixel_ray(view_proj, x, y, w, h);
             // Hits the plane in front within the far plane (depth < 1).
             let t = -origin.y / dir.y;
-            let expected = dir.y < 0.0 && t * dir.dot(Vec3::NEG_Z) < 999.0 && (origin + dir * t).abs().max_element() < s;
+            let expected = dir.y < 0.0
+                && t * dir.dot(Vec3::NEG_Z) < 999.0
+                && (origin + dir * t).abs().max_element() < s;
             let got = fb.depth_at(x, y).expect("depth") < 1.0;
             covered += got as u32;
             if expected != got {
@@ -120,7 +133,10 @@ fn a_triangle_reaching_behind_the_eye_renders_its_visible_part() {
     }
     // Only the horizon row may differ, where the plane meets the far plane.
     assert!(mismatches <= w, "{mismatches} mismatches");
-    assert!(covered as f32 > 0.4 * (w * h) as f32, "the lower half must be ground ({covered})");
+    assert!(
+        covered as f32 > 0.4 * (w * h) as f32,
+        "the lower half must be ground ({covered})"
+    );
 }
 
 #[test]
@@ -131,7 +147,10 @@ fn level_of_detail_grows_along_a_receding_plane_as_the_analytic_footprint() {
     let s = 200.0;
     // The texture repeats 64 times across the plane: about 41 texels per world unit.
     let repeats = 64.0;
-    let plane: Vec<Vtx> = ground(s).into_iter().map(|(p, uv)| (p, uv * repeats)).collect();
+    let plane: Vec<Vtx> = ground(s)
+        .into_iter()
+        .map(|(p, uv)| (p, uv * repeats))
+        .collect();
     let texture = Texture::from_rgba_f32(256, 256, vec![Vec4::ONE; 256 * 256]).expect("texture");
     let lod_shader = FnShader::new(
         2,
@@ -168,13 +187,19 @@ fn level_of_detail_grows_along_a_receding_plane_as_the_analytic_footprint() {
         let dx = (uv_at(cx + e, cy) - uv_at(cx - e, cy)) / (2.0 * e);
         let dy = (uv_at(cx, cy + e) - uv_at(cx, cy - e)) / (2.0 * e);
         let expected = dx.length().max(dy.length()).log2();
-        assert!((lod - expected).abs() < 0.05, "row {y}: lod {lod} vs {expected}");
+        assert!(
+            (lod - expected).abs() < 0.05,
+            "row {y}: lod {lod} vs {expected}"
+        );
         assert!(lod >= previous - 1e-3, "lod must grow towards the horizon");
         previous = lod;
         rows += 1;
     }
     assert!(rows > 20);
-    assert!(previous > 2.0, "far rows are strongly minified ({previous})");
+    assert!(
+        previous > 2.0,
+        "far rows are strongly minified ({previous})"
+    );
 }
 
 #[test]
@@ -183,7 +208,14 @@ fn depth_functions_decide_which_of_two_quads_is_seen() {
     // the function under test.
     let quad = |z: f32, c: f32| -> Vec<Vtx> {
         let v = |x: f32, y: f32| (Vec3::new(x, y, z), Vec2::new(c, c));
-        vec![v(-1.0, -1.0), v(1.0, -1.0), v(1.0, 1.0), v(-1.0, -1.0), v(1.0, 1.0), v(-1.0, 1.0)]
+        vec![
+            v(-1.0, -1.0),
+            v(1.0, -1.0),
+            v(1.0, 1.0),
+            v(-1.0, -1.0),
+            v(1.0, 1.0),
+            v(-1.0, 1.0),
+        ]
     };
     let shader = attribute_shader(Mat4::IDENTITY);
     let first = quad(-0.5, 0.2);
@@ -202,16 +234,23 @@ fn depth_functions_decide_which_of_two_quads_is_seen() {
         let second = quad(second_depth * 2.0 - 1.0, 0.8);
         let mut renderer = Renderer::new(16, 16, RendererOptions::default()).expect("renderer");
         let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
-        frame.draw(&shader, &first, Indices::None, no_cull()).expect("draw");
+        frame
+            .draw(&shader, &first, Indices::None, no_cull())
+            .expect("draw");
         let state = RenderState {
             depth_func: func,
             ..no_cull()
         };
-        frame.draw(&shader, &second, Indices::None, state).expect("draw");
+        frame
+            .draw(&shader, &second, Indices::None, state)
+            .expect("draw");
         frame.end();
         let got = renderer.framebuffer().pixel(5, 9).expect("pixel").x;
         // Interpolation weights sum to 1 within f32 rounding.
-        assert!((got - expected).abs() < 1e-5, "{func:?} with second depth {second_depth}: {got}");
+        assert!(
+            (got - expected).abs() < 1e-5,
+            "{func:?} with second depth {second_depth}: {got}"
+        );
     }
 }
 
@@ -219,32 +258,59 @@ fn depth_functions_decide_which_of_two_quads_is_seen() {
 fn depth_test_off_and_write_off_behave_independently() {
     let quad = |z: f32, c: f32| -> Vec<Vtx> {
         let v = |x: f32, y: f32| (Vec3::new(x, y, z), Vec2::new(c, c));
-        vec![v(-1.0, -1.0), v(1.0, -1.0), v(1.0, 1.0), v(-1.0, -1.0), v(1.0, 1.0), v(-1.0, 1.0)]
+        vec![
+            v(-1.0, -1.0),
+            v(1.0, -1.0),
+            v(1.0, 1.0),
+            v(-1.0, -1.0),
+            v(1.0, 1.0),
+            v(-1.0, 1.0),
+        ]
     };
     let shader = attribute_shader(Mat4::IDENTITY);
     let mut renderer = Renderer::new(8, 8, RendererOptions::default()).expect("renderer");
     let near = quad(-0.5, 0.3);
     let far = quad(0.5, 0.6);
     let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
-    frame.draw(&shader, &near, Indices::None, no_cull()).expect("draw");
+    frame
+        .draw(&shader, &near, Indices::None, no_cull())
+        .expect("draw");
     let untested = RenderState {
         depth_test: false,
         depth_write: false,
         ..no_cull()
     };
-    frame.draw(&shader, &far, Indices::None, untested).expect("draw");
+    frame
+        .draw(&shader, &far, Indices::None, untested)
+        .expect("draw");
     frame.end();
     let fb = renderer.framebuffer();
-    assert!((fb.pixel(3, 3).expect("pixel").x - 0.6).abs() < 1e-5, "depth test off draws over");
-    assert_eq!(fb.depth_at(3, 3), Some(0.25), "depth write off keeps the depth");
+    assert!(
+        (fb.pixel(3, 3).expect("pixel").x - 0.6).abs() < 1e-5,
+        "depth test off draws over"
+    );
+    assert_eq!(
+        fb.depth_at(3, 3),
+        Some(0.25),
+        "depth write off keeps the depth"
+    );
 }
 
 #[test]
 fn fragments_outside_the_depth_range_are_discarded() {
     let v = |x: f32, y: f32| (Vec3::new(x, y, 1.5), Vec2::ONE);
     let beyond_far = vec![v(-1.0, -1.0), v(1.0, -1.0), v(1.0, 1.0)];
-    let renderer = render((8, 8), &attribute_shader(Mat4::IDENTITY), &beyond_far, no_cull());
-    assert!(renderer.framebuffer().read_depth().iter().all(|d| *d == 1.0));
+    let renderer = render(
+        (8, 8),
+        &attribute_shader(Mat4::IDENTITY),
+        &beyond_far,
+        no_cull(),
+    );
+    assert!(renderer
+        .framebuffer()
+        .read_depth()
+        .iter()
+        .all(|d| *d == 1.0));
 }
 
 #[test]
@@ -253,7 +319,14 @@ fn blending_and_back_to_front_sorting() {
     // is drawn first, so the front colour dominates.
     let quad = |z: f32, c: f32| -> Vec<Vtx> {
         let v = |x: f32, y: f32| (Vec3::new(x, y, z), Vec2::new(c, 0.5));
-        vec![v(-1.0, -1.0), v(1.0, -1.0), v(1.0, 1.0), v(-1.0, -1.0), v(1.0, 1.0), v(-1.0, 1.0)]
+        vec![
+            v(-1.0, -1.0),
+            v(1.0, -1.0),
+            v(1.0, 1.0),
+            v(-1.0, -1.0),
+            v(1.0, 1.0),
+            v(-1.0, 1.0),
+        ]
     };
     let view_proj = perspective(1.5, 1.0, 0.1, 10.0);
     let mut vertices = quad(-1.0, 1.0); // front, red = 1
@@ -277,8 +350,14 @@ fn blending_and_back_to_front_sorting() {
         renderer.framebuffer().pixel(4, 4).expect("pixel").x
     };
     let (sorted, unsorted) = (draw(true), draw(false));
-    assert!((sorted - 0.5).abs() < 1e-5, "back (0) then front (1): 0·0.5, then 1·0.5 + 0·0.5 = {sorted}");
-    assert!((unsorted - 0.25).abs() < 1e-5, "front then back: 1·0.5, then 0·0.5 + 0.5·0.5 = {unsorted}");
+    assert!(
+        (sorted - 0.5).abs() < 1e-5,
+        "back (0) then front (1): 0·0.5, then 1·0.5 + 0·0.5 = {sorted}"
+    );
+    assert!(
+        (unsorted - 0.25).abs() < 1e-5,
+        "front then back: 1·0.5, then 0·0.5 + 0.5·0.5 = {unsorted}"
+    );
 }
 
 #[test]
@@ -307,7 +386,11 @@ fn bad_input_gives_errors_or_defined_results() {
     let out_of_range = [0u32, 1, 7];
     assert!(matches!(
         frame.draw(&shader, &vertices, Indices::U32(&out_of_range), no_cull()),
-        Err(RenderError::IndexOutOfRange { index: 7, position: 2, .. })
+        Err(RenderError::IndexOutOfRange {
+            index: 7,
+            position: 2,
+            ..
+        })
     ));
     assert!(matches!(
         frame.draw(&shader, &vertices, Indices::U16(&[0, 1]), no_cull()),
@@ -315,7 +398,9 @@ fn bad_input_gives_errors_or_defined_results() {
     ));
     // NaN, infinite, huge and degenerate triangles: drawn as far as defined, never a panic.
     let nasty: [u16; 18] = [0, 1, 3, 0, 4, 2, 0, 5, 2, 0, 6, 5, 0, 0, 1, 1, 5, 6];
-    frame.draw(&shader, &vertices, Indices::U16(&nasty), no_cull()).expect("draw");
+    frame
+        .draw(&shader, &vertices, Indices::U16(&nasty), no_cull())
+        .expect("draw");
     let stats = frame.end();
     assert_eq!(stats.triangles_in, 6);
     assert_eq!(stats.triangles_invalid, 2, "{stats:?}");
@@ -332,12 +417,23 @@ fn bad_input_gives_errors_or_defined_results() {
     ));
     // Textures: empty, wrong size, huge.
     assert!(Texture::from_rgba8(0, 4, &[], kantele::shade::texture::ColorSpace::Srgb).is_err());
-    assert!(Texture::from_rgba8(2, 2, &[0; 15], kantele::shade::texture::ColorSpace::Srgb).is_err());
-    assert!(Texture::from_rgba8(1 << 20, 1, &[], kantele::shade::texture::ColorSpace::Linear).is_err());
+    assert!(
+        Texture::from_rgba8(2, 2, &[0; 15], kantele::shade::texture::ColorSpace::Srgb).is_err()
+    );
+    assert!(
+        Texture::from_rgba8(1 << 20, 1, &[], kantele::shade::texture::ColorSpace::Linear).is_err()
+    );
     // Sampling with NaN coordinates or derivatives is defined.
     let t = Texture::from_rgba_f32(4, 4, vec![Vec4::ONE; 16]).expect("texture");
     let s = Sampler::default();
-    assert_eq!(t.sample_grad(&s, Vec2::NAN, Vec2::ONE, Vec2::ONE), Vec4::ZERO);
-    assert!(t.sample_grad(&s, Vec2::ONE, Vec2::NAN, Vec2::INFINITY).is_finite());
-    assert!(t.sample_grad(&s, Vec2::splat(1e30), Vec2::ZERO, Vec2::ZERO).is_finite());
+    assert_eq!(
+        t.sample_grad(&s, Vec2::NAN, Vec2::ONE, Vec2::ONE),
+        Vec4::ZERO
+    );
+    assert!(t
+        .sample_grad(&s, Vec2::ONE, Vec2::NAN, Vec2::INFINITY)
+        .is_finite());
+    assert!(t
+        .sample_grad(&s, Vec2::splat(1e30), Vec2::ZERO, Vec2::ZERO)
+        .is_finite());
 }

@@ -23,22 +23,42 @@ fn check(name: &str, render: fn(&mut Renderer) -> Result<FrameStats, RenderError
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/reference");
     let path = dir.join(format!("{name}.png"));
     if std::env::var_os("KANTELE_BLESS").is_some() {
-        image::save_buffer(&path, &actual, fb.width(), fb.height(), image::ColorType::Rgba8).expect("bless");
+        image::save_buffer(
+            &path,
+            &actual,
+            fb.width(),
+            fb.height(),
+            image::ColorType::Rgba8,
+        )
+        .expect("bless");
         return;
     }
     let out_dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../target/test-output");
     let fail = |why: String| -> ! {
         std::fs::create_dir_all(&out_dir).expect("output dir");
         let actual_path = out_dir.join(format!("{name}-actual.png"));
-        image::save_buffer(&actual_path, &actual, fb.width(), fb.height(), image::ColorType::Rgba8).expect("write");
+        image::save_buffer(
+            &actual_path,
+            &actual,
+            fb.width(),
+            fb.height(),
+            image::ColorType::Rgba8,
+        )
+        .expect("write");
         panic!("{name}: {why}; actual image in {}", actual_path.display());
     };
     let reference = match image::open(&path) {
         Ok(img) => img.to_rgba8(),
-        Err(e) => fail(format!("reference {} missing or unreadable ({e}); run with KANTELE_BLESS=1", path.display())),
+        Err(e) => fail(format!(
+            "reference {} missing or unreadable ({e}); run with KANTELE_BLESS=1",
+            path.display()
+        )),
     };
     if reference.dimensions() != (fb.width(), fb.height()) {
-        fail(format!("size {:?} differs from the reference", reference.dimensions()));
+        fail(format!(
+            "size {:?} differs from the reference",
+            reference.dimensions()
+        ));
     }
     let mut worst = 0u8;
     let mut differing = 0usize;
@@ -57,7 +77,14 @@ fn check(name: &str, render: fn(&mut Renderer) -> Result<FrameStats, RenderError
     if worst > MAX_CHANNEL_DIFF {
         std::fs::create_dir_all(&out_dir).expect("output dir");
         let diff_path = out_dir.join(format!("{name}-difference.png"));
-        image::save_buffer(&diff_path, &diff, fb.width(), fb.height(), image::ColorType::Rgba8).expect("write");
+        image::save_buffer(
+            &diff_path,
+            &diff,
+            fb.width(),
+            fb.height(),
+            image::ColorType::Rgba8,
+        )
+        .expect("write");
         fail(format!(
             "{differing} pixels differ, worst by {worst} (allowed {MAX_CHANNEL_DIFF}); difference in {}",
             diff_path.display()

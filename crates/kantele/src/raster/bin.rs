@@ -113,20 +113,12 @@ mod tests {
     #[test]
     fn triangles_land_in_every_tile_of_their_box_in_order() {
         let grid = TileGrid::new(256, 256);
-        let mut a = TriangleSetup::default();
-        a.bbox = PixelRect {
-            x0: 60,
-            y0: 0,
-            x1: 70,
-            y1: 10,
+        let with_box = |x0, y0, x1, y1| TriangleSetup {
+            bbox: PixelRect { x0, y0, x1, y1 },
+            ..TriangleSetup::default()
         };
-        let mut b = TriangleSetup::default();
-        b.bbox = PixelRect {
-            x0: 0,
-            y0: 0,
-            x1: 256,
-            y1: 256,
-        };
+        let a = with_box(60, 0, 70, 10);
+        let b = with_box(0, 0, 256, 256);
         let mut bins = TileBins::default();
         let entries = bins.bin_triangles(&grid, &[a, b]);
         assert_eq!(entries, 2 + 16);
