@@ -371,3 +371,94 @@ fn floor_to_i32(x: f32) -> i32 {
     // `as` saturates for out-of-range floats and maps NaN to 0.
     x.floor() as i32
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 4 × 1 texture with texel values 0, 1, 2, 3 in red.
+    fn ramp() -> Texture {
+        let texels = (0..4).map(|i| Vec4::new(i as f32, 0.0, 0.0, 1.0)).collect();
+        Texture::from_rgba_f32(4, 1, texels).expect("texture")
+    }
+
+    fn sampler(wrap: Wrap, filter: Filter) -> Sampler {
+        Sampler {
+            wrap_s: wrap,
+            wrap_t: wrap,
+            mag_filter: filter,
+            min_filter: MinFilter::Nearest,
+        }
+    }
+
+    #[test]
+    fn nearest_with_each_wrap_mode() {
+        let t = ramp();
+        let red = |wrap, u: f32| t.sample_lod(&sampler(wrap, Filter::Nearest), Vec2::new(u, 0.5), 0.0).x;
+        // Texel i covers u in [i/4, (i+1)/4).
+        assert_eq!(red(Wrap::Repeat, 0.1), 0.0);
+        assert_eq!(red(Wrap::Repeat, 0.9), 3.0);
+        assert_eq!(red(Wrap::Repeat, 1.1), 0.0);
+        assert_eq!(red(Wrap::Repeat, -0.1), 3.0);
+        assert_eq!(red(Wrap::ClampToEdge, 1.7), 3.0);
+        assert_eq!(red(Wrap::ClampToEdge, -5.0), 0.0);
+        // Mirrored: [1, 2) runs backwards.
+        assert_eq!(red(Wrap::MirroredRepeat, 1.1), 3.0);
+        assert_eq!(red(Wrap::MirroredRepeat, 1.9), 0.0);
+        assert_eq!(red(Wrap::MirroredRepeat, -0.1), 0.0);
+        assert_eq!(red(Wrap::MirroredRepeat, 2.1), 0.0);
+    }
+
+    #[test]
+    fn bilinear_blends_texel_centres() {
+        let t = ramp();
+        let red = |wrap, u: f32| t.sample_lod(&sampler(wrap, Filter::Linear), Vec2::new(u, 0.5), 0.0).x;
+        // Centres at u = (i + 0.5) / 4: exact values there, linear in between.
+        assert!((red(Wrap::Repeat, 0.375) - 1.0).abs() < 1e-6);
+        assert!((red(Wrap::Repeat, 0.5) - 1.5).abs() < 1e-6);
+        // Beyond the last centre, REPEAT blends with texel 0, CLAMP holds texel 3.
+        assert!((red(Wrap::Repeat, 1.0) - 1.5).abs() < 1e-6);
+        assert!((red(Wrap::ClampToEdge, 1.0) - 3.0).abs() < 1e-6);
+        assert!((red(Wrap::MirroredRepeat, 1.0) - 3.0).abs() < 1e-6);
+    }
+
+    #[test]
+    fn mip_chain_averages_in_linear_space() {
+        // sRGB 188 ≈ linear 0.5; a 2 × 2 of black and sRGB-white averages to linear 0.5.
+        let rgba = [0, 0, 0, 255, 255, 255, 255, 255, 255, 255, 255, 255, 0, 0, 0, 255];
+        let t = Texture::from_rgba8(2, 2, &rgba, ColorSpace::Srgb).expect("texture");
+        assert_eq!(t.levels().len(), 2);
+        let top = t.levels()[1].texels[0];
+        assert!((top.x - 0.5).abs() < 1e-6, "{top:?}");
+        // Non-square and odd sizes go down to 1 × 1.
+        let odd = Texture::from_rgba_f32(5, 3, vec![Vec4::ONE; 15]).expect("texture");
+        let sizes: Vec<(u32, u32)> = odd.levels().iter().map(|l| (l.width, l.height)).collect();
+        assert_eq!(sizes, vec![(5, 3), (2, 1), (1, 1)]);
+        assert_eq!(odd.levels()[2].texels[0], Vec4::ONE);
+    }
+
+    #[test]
+    fn level_selection_follows_opengl() {
+        // Level i has red = i (set the levels by hand to see which is read).
+        let mut t = Texture::from_rgba_f32(8, 8, vec![Vec4::ZERO; 64]).expect("texture");
+        for (i, level) in t.levels.iter_mut().enumerate() {
+            level.texels.fill(Vec4::new(i as f32, 0.0, 0.0, 1.0));
+        }
+        let with = |min_filter| Sampler {
+            min_filter,
+            ..Sampler::default()
+        };
+        let uv = Vec2::splat(0.3);
+        let red = |min, lod: f32| t.sample_lod(&with(min), uv, lod).x;
+        assert_eq!(red(MinFilter::LinearMipmapNearest, 0.4), 0.0);
+        assert_eq!(red(MinFilter::LinearMipmapNearest, 0.6), 1.0);
+        assert_eq!(red(MinFilter::NearestMipmapNearest, 1.49), 1.0);
+        assert_eq!(red(MinFilter::NearestMipmapNearest, 1.51), 2.0);
+        assert!((red(MinFilter::LinearMipmapLinear, 1.25) - 1.25).abs() < 1e-6);
+        assert_eq!(red(MinFilter::LinearMipmapLinear, 10.0), 3.0);
+        assert_eq!(red(MinFilter::Linear, 2.0), 0.0, "no mipmaps: level 0");
+        assert_eq!(red(MinFilter::LinearMipmapLinear, -1.0), 0.0, "magnified: level 0");
+        // λ = log2 of the larger footprint in texels.
+        assert!((t.lod(Vec2::new(0.5, 0.0), Vec2::new(0.0, 0.125)) - 2.0).abs() < 1e-6);
+    }
+}
