@@ -121,7 +121,7 @@ mod tests {
         assert!(right.x > 0.0);
         let r = rows(&cv);
         assert_eq!(r[1], [0.0, -1.0, 0.0, 0.0]);
-        assert_eq!(r[2], [0.0, 0.0, 1.0, -5.0]);
+        assert_eq!(r[2], [0.0, 0.0, -1.0, 5.0]);
     }
 
     #[test]
