@@ -523,6 +523,100 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 mod tests {
     use super::*;
 
+    fn synthetic() -> FrameImage {
+        // 3x2: background, then covered pixels with ids / normals / colours.
+        FrameImage {
+            width: 3,
+            height: 2,
+            color: vec![
+                [0.0, 0.0, 0.0, 0.0],
+                [1.0, 2.0, 3.0, 1.0],
+                [300.0, 65535.0, 7.0, 1.0],
+                [0.0, 0.0, 1.0, 1.0],
+                [0.0, -1.0, 0.0, 1.0],
+                [1.0, 0.0, 0.0, 1.0],
+            ],
+            depth: vec![1.0, 0.5, 0.25, 0.75, 0.1, 0.9],
+        }
+    }
+
+    fn tmp(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("kantele-render-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir.join(name)
+    }
+
+    #[test]
+    fn ids_png_is_16_bit_with_exact_values() {
+        let p = tmp("ids.png");
+        let mut ids = synthetic();
+        ids.color[4] = [4.0, 5.0, 6.0, 1.0];
+        write_ids(&p, &ids).unwrap();
+        let img = image::open(&p).unwrap();
+        assert_eq!(img.color(), image::ColorType::Rgb16);
+        let img = img.to_rgb16();
+        assert_eq!(img.get_pixel(0, 0).0, [0, 0, 0]);
+        assert_eq!(img.get_pixel(1, 0).0, [1, 2, 3]);
+        assert_eq!(img.get_pixel(2, 0).0, [300, 65535, 7]);
+        std::fs::remove_file(&p).unwrap();
+
+        let mut big = ids.clone();
+        big.color[1][1] = 65536.0;
+        let err = write_ids(&p, &big).unwrap_err().to_string();
+        assert!(err.contains(".exr"), "{err}");
+        assert!(!p.exists());
+
+        let e = tmp("ids.exr");
+        write_ids(&e, &big).unwrap();
+        let img = image::open(&e).unwrap().to_rgb32f();
+        assert_eq!(img.get_pixel(1, 0).0, [1.0, 65536.0, 3.0]);
+        std::fs::remove_file(&e).unwrap();
+    }
+
+    #[test]
+    fn normals_png_encoding() {
+        let p = tmp("n.png");
+        write_normals(&p, &synthetic()).unwrap();
+        let img = image::open(&p).unwrap().to_rgba8();
+        assert_eq!(img.get_pixel(0, 0).0, [0, 0, 0, 0]);
+        assert_eq!(img.get_pixel(0, 1).0, [128, 128, 255, 255]);
+        assert_eq!(img.get_pixel(1, 1).0, [128, 0, 128, 255]);
+        std::fs::remove_file(&p).unwrap();
+    }
+
+    #[test]
+    fn depth_files() {
+        let frame = synthetic();
+        let projection = kantele::camera::perspective(1.0, 1.5, 0.5, 10.0);
+        let view = FrameView {
+            width: 3,
+            height: 2,
+            view: glam::Mat4::IDENTITY,
+            projection,
+            to_light: Vec3::Z,
+            light_color: Vec3::ONE,
+            pass: Pass::Color,
+        };
+        let eye = depth_values(&frame, DepthKind::Eye, &view);
+        assert!(eye[0].is_infinite());
+        assert!(eye[1..]
+            .iter()
+            .all(|d| d.is_finite() && *d >= 0.5 && *d <= 10.0));
+        let p = tmp("d.pfm");
+        write_depth(&p, &frame, &eye).unwrap();
+        let (w, h, back) = output::decode_pfm(std::fs::File::open(&p).unwrap()).unwrap();
+        assert_eq!((w, h), (3, 2));
+        assert_eq!(back, eye);
+        std::fs::remove_file(&p).unwrap();
+        let e = tmp("d.exr");
+        let window = depth_values(&frame, DepthKind::Window, &view);
+        write_depth(&e, &frame, &window).unwrap();
+        let img = image::open(&e).unwrap().to_rgb32f();
+        assert_eq!(img.get_pixel(0, 0).0, [1.0; 3]);
+        assert_eq!(img.get_pixel(2, 1).0, [0.9; 3]);
+        std::fs::remove_file(&e).unwrap();
+    }
+
     #[test]
     fn orbit_cameras_circle_the_scene() {
         let mut scene = Scene::default();
