@@ -43,6 +43,9 @@ pub fn summarize(times: &[f64]) -> Option<Timing> {
     })
 }
 
+/// A backend, or why it could not start.
+type MaybeBackend = Result<Box<dyn Backend>, String>;
+
 struct Row {
     scene: String,
     width: u32,
@@ -125,7 +128,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     let several = args.backends.len() > 1;
     // Each backend is created once and reused for every scene.
-    let mut backends: Vec<(String, Result<Box<dyn Backend>, String>)> = Vec::new();
+    let mut backends: Vec<(String, MaybeBackend)> = Vec::new();
     for kind in &args.backends {
         match make_backend(*kind, &args.cpu, true) {
             Ok(b) => backends.push((kind.name().to_string(), Ok(b))),

@@ -249,6 +249,7 @@ Exit status: 1 when a tolerance is broken (each broken one is named on stderr), 
 
 /// `kantele view`.
 #[derive(Debug, Args)]
+#[command(after_long_help = VIEW_HELP)]
 pub struct ViewArgs {
     /// The scene to view.
     #[command(flatten)]
@@ -269,6 +270,16 @@ pub struct ViewArgs {
     #[arg(long, hide = true, value_name = "PATH")]
     pub screenshot: Option<PathBuf>,
 }
+
+const VIEW_HELP: &str = "\
+Controls:
+  left drag   rotate around the centre of the scene's bounding sphere
+  wheel       zoom
+  S           next CPU traversal strategy (bbox, incremental, block, adaptive, bisector)
+  B           toggle the cpu / gl backend (when the OpenGL backend can start)
+  Esc, Q      quit
+The window title shows the scene, frames per second and the strategy. The first frames use the
+scene's own camera; dragging or zooming switches to the orbit camera.";
 
 /// Parses `WxH` with both sides in `1..=MAX_TARGET_SIZE`.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {

@@ -347,7 +347,8 @@ pub fn run(args: ViewArgs) -> Result<()> {
             bail!("{}: the screenshot must be a .png file", p.display());
         }
     }
-    if std::env::var_os("DISPLAY").is_none() && std::env::var_os("WAYLAND_DISPLAY").is_none() {
+    let set = |v: &str| std::env::var_os(v).is_some_and(|s| !s.is_empty());
+    if !set("DISPLAY") && !set("WAYLAND_DISPLAY") && !set("WAYLAND_SOCKET") {
         bail!("view: no display to open a window on (neither DISPLAY nor WAYLAND_DISPLAY is set)");
     }
     let loaded = input.load()?;

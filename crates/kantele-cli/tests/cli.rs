@@ -566,9 +566,10 @@ fn compare_cpu_and_gl() {
     for f in ["cube-cpu.png", "cube-gl.png", "cube-diff.png"] {
         assert!(dir.path("cmp").join(f).exists(), "{f} missing");
     }
-    // Impossible tolerance: exit status 1 and a message naming the metric.
+    // A negative tolerance is a usage error (status 2), not a broken tolerance (status 1).
     let o = kantele(&["compare", "--builtin", "cube", "--max-mean-diff", "-1"]);
-    assert!(!o.status.success());
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--max-mean-diff"));
 }
 
 #[test]
