@@ -225,10 +225,20 @@ pub struct CompareArgs {
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Largest share of pixels (0..1) whose coverage may differ.
-    #[arg(long, default_value_t = 0.001, value_name = "F")]
+    #[arg(
+        long,
+        default_value_t = 0.001,
+        value_name = "F",
+        allow_negative_numbers = true
+    )]
     pub max_coverage_diff: f64,
     /// Largest mean absolute 8-bit sRGB difference over the RGB channels of all pixels.
-    #[arg(long, default_value_t = 1.0, value_name = "F")]
+    #[arg(
+        long,
+        default_value_t = 1.0,
+        value_name = "F",
+        allow_negative_numbers = true
+    )]
     pub max_mean_diff: f64,
     /// CPU backend options.
     #[command(flatten)]

@@ -26,7 +26,6 @@ fn render(backend: &mut dyn Backend, view: &FrameView, label: &str) -> Result<Fr
 
 /// Runs `kantele compare`; `Ok(false)` when a tolerance is broken.
 pub fn run(args: &CompareArgs) -> Result<bool> {
-    let inputs = scenes::inputs(&args.input)?;
     if args.backends.len() < 2 {
         bail!("--backends: compare needs at least two backends (e.g. cpu,gl)");
     }
@@ -43,6 +42,7 @@ pub fn run(args: &CompareArgs) -> Result<bool> {
             bail!("{name}: {value} is not a non-negative number");
         }
     }
+    let inputs = scenes::inputs(&args.input)?;
     if let Some(dir) = &args.out {
         std::fs::create_dir_all(dir).map_err(|e| anyhow!("{}: {e}", dir.display()))?;
     }
