@@ -1,0 +1,237 @@
+//! `kantele bench`: frame times per scene and backend, by the timing rules of the reference
+//! scenes (warm-up, then N timed `render()` calls; median, min, max).
+
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::{anyhow, bail, Result};
+use kantele::backend::{Backend, FrameView};
+use serde_json::json;
+
+use crate::backends::make_backend;
+use crate::cli::BenchArgs;
+use crate::scenes::{self, Warnings};
+
+/// Summary of timed frames in milliseconds.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Timing {
+    /// Median (mean of the two middle values for an even count).
+    pub median: f64,
+    /// Fastest frame.
+    pub min: f64,
+    /// Slowest frame.
+    pub max: f64,
+}
+
+/// Median, min and max of frame times; `None` for no frames.
+pub fn summarize(times: &[f64]) -> Option<Timing> {
+    if times.is_empty() {
+        return None;
+    }
+    let mut t = times.to_vec();
+    t.sort_by(f64::total_cmp);
+    let n = t.len();
+    let median = if n % 2 == 1 {
+        t[n / 2]
+    } else {
+        (t[n / 2 - 1] + t[n / 2]) / 2.0
+    };
+    Some(Timing {
+        median,
+        min: t[0],
+        max: t[n - 1],
+    })
+}
+
+/// A backend, or why it could not start.
+type MaybeBackend = Result<Box<dyn Backend>, String>;
+
+struct Row {
+    scene: String,
+    width: u32,
+    height: u32,
+    triangles: usize,
+    draws: usize,
+    backend: String,
+    renderer: String,
+    threads: usize,
+    result: Result<Timing, String>,
+    ratio: Option<f64>,
+}
+
+fn time_frames(
+    backend: &mut dyn Backend,
+    view: &FrameView,
+    warmup: u32,
+    frames: u32,
+) -> Result<Timing, String> {
+    for _ in 0..warmup {
+        backend.render(view).map_err(|e| e.to_string())?;
+    }
+    let mut times = Vec::with_capacity(frames as usize);
+    for _ in 0..frames {
+        let start = Instant::now();
+        backend.render(view).map_err(|e| e.to_string())?;
+        times.push(start.elapsed().as_secs_f64() * 1000.0);
+    }
+    summarize(&times).ok_or_else(|| "no frames timed".to_string())
+}
+
+fn print_table(rows: &[Row], ratios: bool) {
+    let mut header = format!(
+        "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:>10} {:>10} {:>10}",
+        "scene",
+        "size",
+        "triangles",
+        "draws",
+        "backend",
+        "renderer",
+        "threads",
+        "median ms",
+        "min ms",
+        "max ms"
+    );
+    if ratios {
+        header.push_str(&format!(" {:>8}", "ratio"));
+    }
+    println!("{header}");
+    for r in rows {
+        let size = format!("{}x{}", r.width, r.height);
+        let mut line = format!(
+            "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7}",
+            r.scene, size, r.triangles, r.draws, r.backend, r.renderer, r.threads
+        );
+        match &r.result {
+            Ok(t) => {
+                line.push_str(&format!(
+                    " {:>10.3} {:>10.3} {:>10.3}",
+                    t.median, t.min, t.max
+                ));
+                if ratios {
+                    match r.ratio {
+                        Some(x) => line.push_str(&format!(" {x:>8.3}")),
+                        None => line.push_str(&format!(" {:>8}", "-")),
+                    }
+                }
+            }
+            Err(e) => line.push_str(&format!(" unavailable: {e}")),
+        }
+        println!("{line}");
+    }
+}
+
+/// Runs `kantele bench`.
+pub fn run(args: &BenchArgs) -> Result<()> {
+    let inputs = scenes::inputs(&args.input)?;
+    if args.backends.is_empty() {
+        bail!("--backend: no backend given");
+    }
+    let several = args.backends.len() > 1;
+    // Each backend is created once and reused for every scene.
+    let mut backends: Vec<(String, MaybeBackend)> = Vec::new();
+    for kind in &args.backends {
+        match make_backend(*kind, &args.cpu, true) {
+            Ok(b) => backends.push((kind.name().to_string(), Ok(b))),
+            Err(e) if several => {
+                eprintln!("kantele: warning: {e}; continuing without it");
+                backends.push((kind.name().to_string(), Err(e.to_string())));
+            }
+            Err(e) => return Err(e),
+        }
+    }
+
+    let mut warnings = Warnings::default();
+    let mut rows = Vec::new();
+    for input in &inputs {
+        let label = input.label();
+        let loaded = input.load()?;
+        warnings.report(&loaded, |w| eprintln!("{w}"));
+        let scene = Arc::new(loaded.scene);
+        let (width, height) = args.size.unwrap_or(scene.resolution);
+        let view = FrameView::with_camera(&scene, &scene.camera, width, height);
+        let mut reference: Option<f64> = None;
+        let mut any_ok = false;
+        for (i, (name, backend)) in backends.iter_mut().enumerate() {
+            let (renderer, threads, result) = match backend {
+                Ok(b) => {
+                    let result = b
+                        .load(scene.clone())
+                        .map_err(|e| e.to_string())
+                        .and_then(|()| time_frames(b.as_mut(), &view, args.warmup, args.frames));
+                    (b.renderer(), b.threads(), result)
+                }
+                Err(e) => ("-".to_string(), 0, Err(e.clone())),
+            };
+            if let Err(e) = &result {
+                if !several {
+                    bail!("{label}: {e}");
+                }
+                eprintln!("kantele: warning: {label}: {name}: {e}");
+            }
+            let median = result.as_ref().ok().map(|t| t.median);
+            any_ok |= median.is_some();
+            if i == 0 {
+                reference = median;
+            }
+            let ratio = match (median, reference) {
+                (Some(m), Some(r)) if i > 0 && r > 0.0 => Some(m / r),
+                _ => None,
+            };
+            let row = Row {
+                scene: input.stem(),
+                width,
+                height,
+                triangles: scene.triangle_count(),
+                draws: scene.draws.len(),
+                backend: name.clone(),
+                renderer,
+                threads,
+                result,
+                ratio,
+            };
+            if args.json {
+                let (median, min, max, error) = match &row.result {
+                    Ok(t) => (Some(t.median), Some(t.min), Some(t.max), None),
+                    Err(e) => (None, None, None, Some(e.clone())),
+                };
+                println!(
+                    "{}",
+                    json!({
+                        "scene": row.scene, "source": loaded.info.source,
+                        "width": row.width, "height": row.height,
+                        "triangles": row.triangles, "draws": row.draws,
+                        "backend": row.backend, "renderer": row.renderer, "threads": row.threads,
+                        "frames": args.frames, "warmup": args.warmup,
+                        "median_ms": median, "min_ms": min, "max_ms": max,
+                        "ratio": row.ratio, "available": error.is_none(), "error": error,
+                    })
+                );
+            }
+            rows.push(row);
+        }
+        if !any_ok {
+            if !args.json {
+                print_table(&rows, several);
+            }
+            return Err(anyhow!("{label}: no backend could render it"));
+        }
+    }
+    if !args.json {
+        print_table(&rows, several);
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn summary() {
+        assert_eq!(summarize(&[]), None);
+        let t = summarize(&[3.0, 1.0, 2.0]).unwrap();
+        assert_eq!((t.median, t.min, t.max), (2.0, 1.0, 3.0));
+        let t = summarize(&[4.0, 1.0, 2.0, 3.0]).unwrap();
+        assert_eq!((t.median, t.min, t.max), (2.5, 1.0, 4.0));
+    }
+}

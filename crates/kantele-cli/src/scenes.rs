@@ -1,0 +1,107 @@
+//! Scene inputs (files and built-ins), loading with file-naming errors, warnings printed once.
+
+use std::collections::HashSet;
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Result};
+use kantele_io::LoadedScene;
+
+use crate::cli::SceneArgs;
+
+/// One scene to load.
+#[derive(Clone, Debug)]
+pub enum Input {
+    /// A scene file.
+    File(PathBuf),
+    /// A built-in scene by name.
+    Builtin(String),
+}
+
+impl Input {
+    /// What names outputs: the file stem or the built-in's name.
+    pub fn stem(&self) -> String {
+        match self {
+            Input::File(p) => p
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "scene".into()),
+            Input::Builtin(n) => n.clone(),
+        }
+    }
+
+    /// How errors name it.
+    pub fn label(&self) -> String {
+        match self {
+            Input::File(p) => p.display().to_string(),
+            Input::Builtin(n) => format!("builtin:{n}"),
+        }
+    }
+
+    /// Loads the scene; errors name the file.
+    pub fn load(&self) -> Result<LoadedScene> {
+        let loaded = match self {
+            Input::File(p) => kantele_io::load_scene(p).map_err(|e| anyhow!("{e}"))?,
+            Input::Builtin(n) => {
+                kantele_io::builtin_scene(n).map_err(|e| anyhow!("{}: {e}", self.label()))?
+            }
+        };
+        loaded
+            .scene
+            .validate()
+            .map_err(|e| anyhow!("{}: {e}", self.label()))?;
+        Ok(loaded)
+    }
+}
+
+/// The inputs of a command, files first; checks that files exist and built-ins are known
+/// before anything is rendered.
+pub fn inputs(args: &SceneArgs) -> Result<Vec<Input>> {
+    let mut out = Vec::new();
+    for p in &args.scenes {
+        match std::fs::metadata(p) {
+            Ok(m) if m.is_file() => {}
+            Ok(_) => bail!("{}: not a file", p.display()),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+                bail!("{}: no such file", p.display())
+            }
+            Err(e) => bail!("{}: {e}", p.display()),
+        }
+        out.push(Input::File(p.clone()));
+    }
+    let known = kantele_io::builtin_scenes();
+    for n in &args.builtins {
+        if !known.iter().any(|(name, _)| name == n) {
+            let names: Vec<&str> = known.iter().map(|(n, _)| *n).collect();
+            bail!(
+                "builtin:{n}: no built-in scene named '{n}' (available: {})",
+                if names.is_empty() {
+                    "none".to_string()
+                } else {
+                    names.join(", ")
+                }
+            );
+        }
+        out.push(Input::Builtin(n.clone()));
+    }
+    if out.is_empty() {
+        bail!("no scene given: name a scene file or use --builtin NAME");
+    }
+    Ok(out)
+}
+
+/// Prints each loader warning once per run as `kantele: warning: ...`.
+#[derive(Default)]
+pub struct Warnings {
+    seen: HashSet<String>,
+}
+
+impl Warnings {
+    /// Prints the warnings not printed yet (through `print`, so a progress bar can step aside).
+    pub fn report(&mut self, loaded: &LoadedScene, mut print: impl FnMut(&str)) {
+        for w in &loaded.info.warnings {
+            if self.seen.insert(w.clone()) {
+                print(&format!("kantele: warning: {}: {}", loaded.info.source, w));
+            }
+        }
+    }
+}

@@ -1,0 +1,618 @@
+//! End-to-end tests of the `kantele` binary.
+//!
+//! Tests that need the real renderer and loaders (built-in scenes, shared scenes) are written
+//! against the expected behaviour. Tests reading `shared/scenes` skip with a message when the
+//! directory is absent; the viewer test skips when `xvfb-run` is not on PATH.
+
+use std::collections::HashSet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+const BIN: &str = env!("CARGO_BIN_EXE_kantele");
+
+/// A fresh directory removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> Self {
+        use std::sync::atomic::{AtomicUsize, Ordering};
+        static COUNTER: AtomicUsize = AtomicUsize::new(0);
+        let n = COUNTER.fetch_add(1, Ordering::SeqCst);
+        let dir =
+            std::env::temp_dir().join(format!("kantele-cli-{tag}-{}-{n}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        TempDir(dir)
+    }
+    fn path(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+    fn s(&self, name: &str) -> String {
+        self.path(name).to_string_lossy().into_owned()
+    }
+    fn files(&self) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(&self.0)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn kantele(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().expect("run kantele")
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn ok(o: &Output) {
+    assert!(
+        o.status.success(),
+        "kantele failed ({:?}):\n{}",
+        o.status,
+        stderr(o)
+    );
+}
+
+/// A failure: non-zero status, exactly one line `kantele: error: ...` mentioning `needle`, no
+/// panic, nothing written to `dir`.
+fn assert_clean_failure(o: &Output, needle: &str, dir: &TempDir, keep: &[&str]) {
+    let err = stderr(o);
+    assert!(
+        !o.status.success(),
+        "expected failure, got success; stderr: {err}"
+    );
+    assert!(!err.contains("panicked"), "panic: {err}");
+    let lines: Vec<&str> = err.lines().filter(|l| !l.trim().is_empty()).collect();
+    assert_eq!(lines.len(), 1, "expected one line on stderr, got: {err}");
+    assert!(lines[0].starts_with("kantele: error: "), "{err}");
+    assert!(
+        lines[0].contains(needle),
+        "message should mention '{needle}': {err}"
+    );
+    let left: Vec<String> = dir
+        .files()
+        .into_iter()
+        .filter(|f| !keep.contains(&f.as_str()))
+        .collect();
+    assert!(left.is_empty(), "files left behind: {left:?}");
+}
+
+fn shared_scenes() -> Option<PathBuf> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        eprintln!("skipping: {} is absent", dir.display());
+        None
+    }
+}
+
+fn distinct_colors(img: &image::RgbaImage) -> usize {
+    img.pixels().map(|p| p.0).collect::<HashSet<_>>().len()
+}
+
+// ---------------------------------------------------------------- errors (work without a renderer)
+
+#[test]
+fn version_and_help() {
+    let o = kantele(&["--version"]);
+    ok(&o);
+    assert!(stdout(&o).starts_with("kantele "));
+    for sub in ["render", "info", "bench", "compare", "view"] {
+        let o = kantele(&[sub, "--help"]);
+        ok(&o);
+        assert!(stdout(&o).contains("Usage"), "{sub} --help: {}", stdout(&o));
+    }
+    assert!(stdout(&kantele(&["render", "--help"])).contains("{stem}"));
+}
+
+#[test]
+fn missing_file() {
+    let dir = TempDir::new("missing");
+    let o = kantele(&["render", &dir.s("nope.glb"), "-o", &dir.s("out.png")]);
+    assert_clean_failure(&o, "nope.glb", &dir, &[]);
+    let o = kantele(&["info", &dir.s("nope.glb")]);
+    assert_clean_failure(&o, "nope.glb", &dir, &[]);
+    let o = kantele(&["bench", &dir.s("nope.glb"), "--frames", "2"]);
+    assert_clean_failure(&o, "nope.glb", &dir, &[]);
+}
+
+#[test]
+fn garbage_glb() {
+    let dir = TempDir::new("garbage");
+    std::fs::write(
+        dir.path("broken.glb"),
+        b"glTF\x02\x00\x00\x00garbage garbage",
+    )
+    .unwrap();
+    let o = kantele(&["render", &dir.s("broken.glb"), "-o", &dir.s("out.png")]);
+    assert_clean_failure(&o, "broken.glb", &dir, &["broken.glb"]);
+    let o = kantele(&["info", &dir.s("broken.glb")]);
+    assert_clean_failure(&o, "broken.glb", &dir, &["broken.glb"]);
+}
+
+#[test]
+fn truncated_glb() {
+    let Some(scenes) = shared_scenes() else {
+        return;
+    };
+    let dir = TempDir::new("truncated");
+    let bytes = std::fs::read(scenes.join("bunny.glb")).unwrap();
+    std::fs::write(dir.path("cut.glb"), &bytes[..bytes.len() / 2]).unwrap();
+    let o = kantele(&["render", &dir.s("cut.glb"), "-o", &dir.s("out.png")]);
+    assert_clean_failure(&o, "cut.glb", &dir, &["cut.glb"]);
+}
+
+#[test]
+fn bad_sizes() {
+    let dir = TempDir::new("sizes");
+    for size in ["0x0", "100000x100000", "16385x2", "12", "axb"] {
+        let o = kantele(&[
+            "render",
+            "--builtin",
+            "cube",
+            "-o",
+            &dir.s("out.png"),
+            "--size",
+            size,
+        ]);
+        assert_clean_failure(&o, "size", &dir, &[]);
+    }
+}
+
+#[test]
+fn unknown_strategy() {
+    let dir = TempDir::new("strategy");
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "-o",
+        &dir.s("out.png"),
+        "--strategy",
+        "zigzag",
+    ]);
+    assert_clean_failure(&o, "zigzag", &dir, &[]);
+}
+
+#[test]
+fn unknown_builtin() {
+    let dir = TempDir::new("builtin");
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "dodecahedron",
+        "-o",
+        &dir.s("out.png"),
+    ]);
+    assert_clean_failure(&o, "dodecahedron", &dir, &[]);
+}
+
+#[test]
+fn several_inputs_need_a_template() {
+    let dir = TempDir::new("template");
+    std::fs::write(dir.path("a.glb"), b"x").unwrap();
+    std::fs::write(dir.path("b.glb"), b"y").unwrap();
+    let o = kantele(&[
+        "render",
+        &dir.s("a.glb"),
+        &dir.s("b.glb"),
+        "-o",
+        &dir.s("out.png"),
+    ]);
+    assert_clean_failure(&o, "out.png", &dir, &["a.glb", "b.glb"]);
+    let o = kantele(&[
+        "render",
+        &dir.s("a.glb"),
+        "--orbit",
+        "3",
+        "-o",
+        &dir.s("out.png"),
+    ]);
+    assert_clean_failure(&o, "out.png", &dir, &["a.glb", "b.glb"]);
+    let o = kantele(&["render", &dir.s("a.glb"), "-o", &dir.s("{bogus}.png")]);
+    assert_clean_failure(&o, "bogus", &dir, &["a.glb", "b.glb"]);
+}
+
+#[test]
+fn unsupported_output_types() {
+    let dir = TempDir::new("types");
+    std::fs::write(dir.path("a.glb"), b"x").unwrap();
+    let keep = ["a.glb"];
+    let o = kantele(&["render", &dir.s("a.glb"), "-o", &dir.s("out.jpg")]);
+    assert_clean_failure(&o, "out.jpg", &dir, &keep);
+    let o = kantele(&[
+        "render",
+        &dir.s("a.glb"),
+        "-o",
+        &dir.s("out.png"),
+        "--depth",
+        &dir.s("d.png"),
+    ]);
+    assert_clean_failure(&o, "d.png", &dir, &keep);
+    let o = kantele(&[
+        "render",
+        &dir.s("a.glb"),
+        "-o",
+        &dir.s("out.png"),
+        "--ids",
+        &dir.s("out.png"),
+    ]);
+    assert_clean_failure(&o, "out.png", &dir, &keep);
+}
+
+#[test]
+fn no_scene_given() {
+    let o = kantele(&["render", "-o", "x.png"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).starts_with("kantele: error: "));
+    assert!(!Path::new("x.png").exists());
+}
+
+// ------------------------------------------------------- need the real loaders and CPU renderer
+
+fn scene_resolution(args: &[&str]) -> (u32, u32) {
+    let mut a = vec!["info", "--json"];
+    a.extend_from_slice(args);
+    let o = kantele(&a);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    let r = &v["resolution"];
+    (r[0].as_u64().unwrap() as u32, r[1].as_u64().unwrap() as u32)
+}
+
+#[test]
+fn render_builtin_cube() {
+    let dir = TempDir::new("cube");
+    let (w, h) = scene_resolution(&["--builtin", "cube"]);
+    let out = dir.s("cube.png");
+    let o = kantele(&["render", "--builtin", "cube", "-o", &out, "--json"]);
+    ok(&o);
+    let img = image::open(&out).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (w, h));
+    assert!(distinct_colors(&img) > 2, "picture is too flat");
+    let line: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert_eq!(line["scene"], "cube");
+    assert_eq!(line["width"], w);
+    assert!(line["ms"].as_f64().unwrap() >= 0.0);
+    let side: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path("cube.png.json")).unwrap()).unwrap();
+    for key in ["fx", "fy", "cx", "cy", "yfov", "znear"] {
+        assert!(
+            side["camera"][key].is_number(),
+            "sidecar camera.{key}: {side}"
+        );
+    }
+    assert_eq!(side["backend"], "cpu");
+    assert_eq!(side["world_to_camera_opencv"].as_array().unwrap().len(), 4);
+    assert_eq!(dir.files(), vec!["cube.png", "cube.png.json"]);
+}
+
+fn read_pfm(path: &Path) -> (u32, u32, Vec<f32>) {
+    let data = std::fs::read(path).unwrap();
+    let text_end = {
+        let mut newlines = 0;
+        data.iter()
+            .position(|&b| {
+                if b == b'\n' {
+                    newlines += 1;
+                }
+                newlines == 3
+            })
+            .unwrap()
+            + 1
+    };
+    let header = std::str::from_utf8(&data[..text_end]).unwrap();
+    let mut it = header.split_whitespace();
+    assert_eq!(it.next(), Some("Pf"));
+    let w: u32 = it.next().unwrap().parse().unwrap();
+    let h: u32 = it.next().unwrap().parse().unwrap();
+    assert_eq!(it.next(), Some("-1.0"));
+    let vals: Vec<f32> = data[text_end..]
+        .chunks_exact(4)
+        .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+        .collect();
+    assert_eq!(vals.len(), (w * h) as usize);
+    (w, h, vals)
+}
+
+#[test]
+fn render_all_passes() {
+    let dir = TempDir::new("passes");
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "--size",
+        "96x64",
+        "-o",
+        &dir.s("c.png"),
+        "--depth",
+        &dir.s("d.pfm"),
+        "--normals",
+        &dir.s("n.png"),
+        "--ids",
+        &dir.s("i.png"),
+    ]);
+    ok(&o);
+    let (w, h, depth) = read_pfm(&dir.path("d.pfm"));
+    assert_eq!((w, h), (96, 64));
+    assert!(depth.iter().any(|d| d.is_infinite()), "no background");
+    assert!(
+        depth.iter().any(|d| d.is_finite() && *d > 0.0),
+        "no geometry"
+    );
+    let normals = image::open(dir.path("n.png")).unwrap().to_rgba8();
+    assert_eq!(normals.dimensions(), (96, 64));
+    let ids = image::open(dir.path("i.png")).unwrap().to_rgb16();
+    assert_eq!(ids.dimensions(), (96, 64));
+    assert!(ids
+        .pixels()
+        .any(|p| p.0[0] >= 1 && p.0[1] >= 1 && p.0[2] >= 1));
+    assert!(ids.pixels().any(|p| p.0 == [0, 0, 0]));
+    // Background agrees between depth and ids.
+    for (i, p) in ids.pixels().enumerate() {
+        assert_eq!(p.0[0] == 0, depth[i].is_infinite(), "pixel {i}");
+    }
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "--size",
+        "32x32",
+        "-o",
+        &dir.s("w.exr"),
+        "--depth",
+        &dir.s("w-depth.exr"),
+        "--depth-kind",
+        "window",
+    ]);
+    ok(&o);
+    let d = image::open(dir.path("w-depth.exr")).unwrap().to_rgb32f();
+    assert!(d.pixels().any(|p| p.0[0] == 1.0));
+    assert!(d.pixels().all(|p| (0.0..=1.0).contains(&p.0[0])));
+}
+
+#[test]
+fn render_orbit() {
+    let dir = TempDir::new("orbit");
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "--size",
+        "48x48",
+        "--orbit",
+        "3",
+        "-o",
+        &dir.s("{stem}-{frame}.png"),
+    ]);
+    ok(&o);
+    let files = dir.files();
+    assert_eq!(
+        files,
+        vec![
+            "cube-0000.png",
+            "cube-0000.png.json",
+            "cube-0001.png",
+            "cube-0001.png.json",
+            "cube-0002.png",
+            "cube-0002.png.json",
+        ]
+    );
+    let a = image::open(dir.path("cube-0000.png")).unwrap().to_rgba8();
+    let b = image::open(dir.path("cube-0001.png")).unwrap().to_rgba8();
+    assert!(distinct_colors(&a) > 2);
+    assert_ne!(a, b, "orbit views should differ");
+}
+
+#[test]
+fn render_several_scenes() {
+    let dir = TempDir::new("several");
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "--builtin",
+        "teapot",
+        "--size",
+        "40x30",
+        "-o",
+        &dir.s("{index}-{stem}.png"),
+    ]);
+    ok(&o);
+    assert!(dir.path("0000-cube.png").exists() && dir.path("0001-teapot.png").exists());
+}
+
+#[test]
+fn info_builtin() {
+    let o = kantele(&["info", "--builtin", "cube"]);
+    ok(&o);
+    assert!(stdout(&o).contains("triangles"));
+    let o = kantele(&["info", "--builtin", "teapot", "--json"]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert!(v["triangles"].as_u64().unwrap() > 100);
+}
+
+#[test]
+fn info_bunny() {
+    let Some(scenes) = shared_scenes() else {
+        return;
+    };
+    let path = scenes.join("bunny.glb");
+    let o = kantele(&["info", path.to_str().unwrap(), "--json"]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert_eq!(v["triangles"], 69451);
+    assert_eq!(v["resolution"], serde_json::json!([1024, 768]));
+    let o = kantele(&[
+        "info",
+        scenes.join("spot-textured.glb").to_str().unwrap(),
+        "--json",
+    ]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert_eq!(v["textures"][0]["width"], 1024);
+    assert_eq!(v["textures"][0]["levels"], 11);
+}
+
+#[test]
+fn render_shared_scene_at_its_resolution() {
+    let Some(scenes) = shared_scenes() else {
+        return;
+    };
+    let dir = TempDir::new("shared");
+    let o = kantele(&[
+        "render",
+        scenes.join("blog-teapot.glb").to_str().unwrap(),
+        "-o",
+        &dir.s("t.png"),
+    ]);
+    ok(&o);
+    let img = image::open(dir.path("t.png")).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (192, 192));
+    assert!(distinct_colors(&img) > 2);
+}
+
+#[test]
+fn bench_two_frames() {
+    let o = kantele(&[
+        "bench",
+        "--builtin",
+        "cube",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--json",
+    ]);
+    ok(&o);
+    let out = stdout(&o);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 1, "{out}");
+    let v: serde_json::Value = serde_json::from_str(lines[0]).unwrap();
+    assert_eq!(v["backend"], "cpu");
+    assert_eq!(v["frames"], 2);
+    assert!(v["median_ms"].as_f64().unwrap() > 0.0);
+    assert!(v["min_ms"].as_f64().unwrap() <= v["max_ms"].as_f64().unwrap());
+    let o = kantele(&[
+        "bench",
+        "--builtin",
+        "cube",
+        "--frames",
+        "2",
+        "--warmup",
+        "0",
+    ]);
+    ok(&o);
+    assert!(stdout(&o).contains("median"));
+}
+
+fn gl_available() -> bool {
+    let o = kantele(&[
+        "bench",
+        "--builtin",
+        "cube",
+        "--backend",
+        "gl",
+        "--frames",
+        "1",
+        "--warmup",
+        "0",
+    ]);
+    if !o.status.success() {
+        eprintln!(
+            "skipping: the gl backend is unavailable here: {}",
+            stderr(&o).trim()
+        );
+    }
+    o.status.success()
+}
+
+#[test]
+fn compare_cpu_and_gl() {
+    if !gl_available() {
+        return;
+    }
+    let dir = TempDir::new("compare");
+    let o = kantele(&[
+        "compare",
+        "--builtin",
+        "cube",
+        "--backends",
+        "cpu,gl",
+        "--out",
+        &dir.s("cmp"),
+        "--json",
+    ]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).lines().next().unwrap()).unwrap();
+    assert_eq!(v["passed"], true);
+    for f in ["cube-cpu.png", "cube-gl.png", "cube-diff.png"] {
+        assert!(dir.path("cmp").join(f).exists(), "{f} missing");
+    }
+    // A negative tolerance is a usage error (status 2), not a broken tolerance (status 1).
+    let o = kantele(&["compare", "--builtin", "cube", "--max-mean-diff", "-1"]);
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(stderr(&o).contains("--max-mean-diff"));
+}
+
+#[test]
+fn compare_needs_two_backends() {
+    let o = kantele(&["compare", "--builtin", "cube", "--backends", "cpu"]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("kantele: error:"));
+}
+
+// ----------------------------------------------------------------------------------- viewer
+
+fn on_path(program: &str) -> bool {
+    std::env::var_os("PATH")
+        .map(|p| std::env::split_paths(&p).any(|d| d.join(program).is_file()))
+        .unwrap_or(false)
+}
+
+#[test]
+fn viewer_under_xvfb() {
+    if !on_path("xvfb-run") {
+        eprintln!("skipping: xvfb-run is not on PATH (apt-get install xvfb xauth)");
+        return;
+    }
+    let dir = TempDir::new("view");
+    let shot = dir.s("shot.png");
+    let o = Command::new("xvfb-run")
+        .args([
+            "-a",
+            "-s",
+            "-screen 0 1024x768x24",
+            BIN,
+            "view",
+            "--builtin",
+            "cube",
+            "--size",
+            "160x120",
+        ])
+        .args(["--frames", "5", "--screenshot", &shot])
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .expect("run xvfb-run");
+    ok(&o);
+    let img = image::open(&shot).unwrap().to_rgba8();
+    assert!(img.width() > 0 && img.height() > 0);
+    assert!(distinct_colors(&img) > 1, "screenshot is uniform");
+}
