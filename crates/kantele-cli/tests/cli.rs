@@ -327,6 +327,13 @@ fn read_pfm(path: &Path) -> (u32, u32, Vec<f32>) {
         .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
         .collect();
     assert_eq!(vals.len(), (w * h) as usize);
+    // PFM stores rows bottom to top; return them top to bottom like every other image here.
+    let vals = vals
+        .chunks_exact(w as usize)
+        .rev()
+        .flatten()
+        .copied()
+        .collect();
     (w, h, vals)
 }
 
@@ -570,6 +577,51 @@ fn compare_cpu_and_gl() {
     let o = kantele(&["compare", "--builtin", "cube", "--max-mean-diff", "-1"]);
     assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
     assert!(stderr(&o).contains("--max-mean-diff"));
+}
+
+/// `kantele compare` catches bugs planted in Kantele (built with the `fault-injection`
+/// feature for tests): a flipped fill rule and a flipped texture V axis. The same comparison
+/// passes without the fault.
+#[test]
+fn compare_catches_planted_bugs() {
+    if !gl_available() {
+        return;
+    }
+    let run = |fault: Option<&str>, scene: &str, extra: &[&str]| {
+        let mut cmd = Command::new(BIN);
+        cmd.args(["compare", "--builtin", scene, "--backends", "cpu,gl"])
+            .args(extra);
+        if let Some(f) = fault {
+            cmd.env("KANTELE_FAULT", f);
+        }
+        cmd.output().expect("run kantele")
+    };
+    // Every edge of `pixel-edges` runs through pixel centres: with the right rule Kantele and
+    // OpenGL agree exactly, with the wrong one about a tenth of the coverage differs.
+    let exact = ["--max-coverage-diff", "0"];
+    ok(&run(None, "pixel-edges", &exact));
+    let o = run(Some("fill-rule"), "pixel-edges", &exact);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "fill-rule fault not caught: {}",
+        stderr(&o)
+    );
+    assert!(stderr(&o).contains("pixel-edges"), "{}", stderr(&o));
+    // A mirrored texture V axis on the textured cube.
+    ok(&run(None, "cube", &[]));
+    let o = run(Some("flip-v"), "cube", &[]);
+    assert_eq!(
+        o.status.code(),
+        Some(1),
+        "flip-v fault not caught: {}",
+        stderr(&o)
+    );
+    assert!(
+        stderr(&o).contains("mean colour difference"),
+        "{}",
+        stderr(&o)
+    );
 }
 
 #[test]

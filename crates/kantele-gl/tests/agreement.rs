@@ -41,6 +41,42 @@ fn render_both(path: &Path, gl: &mut GlBackend) -> (FrameImage, FrameImage, Fram
     (a, b, ids)
 }
 
+#[test]
+fn builtin_scenes_agree_with_opengl() {
+    let mut gl = match GlBackend::new() {
+        Ok(gl) => gl,
+        Err(e) => {
+            eprintln!("skipping: OpenGL unavailable: {e}");
+            return;
+        }
+    };
+    for (name, _) in kantele_io::builtin_scenes() {
+        let scene = Arc::new(kantele_io::builtin_scene(name).expect("builtin").scene);
+        let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu");
+        cpu.load(scene.clone()).expect("cpu load");
+        gl.load(scene.clone()).expect("gl load");
+        let view = FrameView::of_scene(&scene);
+        let a = render(&mut cpu, &view);
+        let b = render(&mut gl, &view);
+        let c = compare(&a, &b, None, 0).expect("same size");
+        eprintln!(
+            "{name:12} coverage {} px, mean {:.3}, max {}",
+            c.coverage_mismatches, c.mean_color_diff, c.max_color_diff
+        );
+        assert!(c.coverage_mismatch_fraction() <= 0.001, "{name}: coverage");
+        assert!(
+            c.mean_color_diff < 1.0,
+            "{name}: mean colour {}",
+            c.mean_color_diff
+        );
+        if *name == "pixel-edges" {
+            // Every edge passes through pixel centres: both apply the same top-left rule.
+            assert_eq!(c.coverage_mismatches, 0, "fill rule differs from OpenGL's");
+            assert_eq!(c.max_color_diff, 0);
+        }
+    }
+}
+
 /// Largest colour difference (8-bit) allowed away from triangle edges.
 const INTERIOR_BOUND: u8 = 3;
 

@@ -9,6 +9,8 @@ pub mod compare;
 pub mod cpu;
 pub mod demo;
 pub mod error;
+#[cfg(feature = "fault-injection")]
+pub mod fault;
 pub mod fixed;
 pub mod geometry;
 pub mod material;

@@ -99,6 +99,8 @@ impl EdgeFunction {
         // With y down and positive area, a top edge runs exactly horizontally to the right
         // (a == 0, b > 0) and a left edge runs upwards (a > 0).
         let top_left = a > 0 || (a == 0 && b > 0);
+        #[cfg(feature = "fault-injection")]
+        let top_left = top_left != crate::fault::active(crate::fault::Fault::FillRule);
         Self {
             a,
             b,

@@ -2,6 +2,7 @@
 
 mod cube;
 mod ground;
+mod pixel_edges;
 mod teapot;
 mod teapot_data;
 
@@ -24,6 +25,10 @@ pub const SCENES: &[(&str, &str)] = &[
         "ground",
         "a huge checker ground plane reaching behind the camera, a cube and a triangle standing on it",
     ),
+    (
+        "pixel-edges",
+        "quads whose edges run exactly through pixel centres: only the fill rule decides their edge pixels",
+    ),
 ];
 
 /// Background of the built-in scenes: a dark grey-blue (linear).
@@ -35,6 +40,7 @@ pub fn build(name: &str) -> Option<LoadedScene> {
         "cube" => cube::scene(),
         "teapot" => teapot::scene(),
         "ground" => ground::scene(),
+        "pixel-edges" => pixel_edges::scene(),
         _ => return None,
     };
     Some(finish(name, scene, info))

@@ -171,6 +171,12 @@ impl Texture {
 
     /// Samples at `uv` with an explicit level of detail (OpenGL 4.6 §8.14–8.15).
     pub fn sample_lod(&self, sampler: &Sampler, uv: Vec2, lod: f32) -> Vec4 {
+        #[cfg(feature = "fault-injection")]
+        let uv = if crate::fault::active(crate::fault::Fault::FlipV) {
+            Vec2::new(uv.x, 1.0 - uv.y)
+        } else {
+            uv
+        };
         if !(uv.x.is_finite() && uv.y.is_finite()) {
             return Vec4::ZERO;
         }
@@ -394,7 +400,10 @@ mod tests {
     #[test]
     fn nearest_with_each_wrap_mode() {
         let t = ramp();
-        let red = |wrap, u: f32| t.sample_lod(&sampler(wrap, Filter::Nearest), Vec2::new(u, 0.5), 0.0).x;
+        let red = |wrap, u: f32| {
+            t.sample_lod(&sampler(wrap, Filter::Nearest), Vec2::new(u, 0.5), 0.0)
+                .x
+        };
         // Texel i covers u in [i/4, (i+1)/4).
         assert_eq!(red(Wrap::Repeat, 0.1), 0.0);
         assert_eq!(red(Wrap::Repeat, 0.9), 3.0);
@@ -412,7 +421,10 @@ mod tests {
     #[test]
     fn bilinear_blends_texel_centres() {
         let t = ramp();
-        let red = |wrap, u: f32| t.sample_lod(&sampler(wrap, Filter::Linear), Vec2::new(u, 0.5), 0.0).x;
+        let red = |wrap, u: f32| {
+            t.sample_lod(&sampler(wrap, Filter::Linear), Vec2::new(u, 0.5), 0.0)
+                .x
+        };
         // Centres at u = (i + 0.5) / 4: exact values there, linear in between.
         assert!((red(Wrap::Repeat, 0.375) - 1.0).abs() < 1e-6);
         assert!((red(Wrap::Repeat, 0.5) - 1.5).abs() < 1e-6);
@@ -425,7 +437,9 @@ mod tests {
     #[test]
     fn mip_chain_averages_in_linear_space() {
         // sRGB 188 ≈ linear 0.5; a 2 × 2 of black and sRGB-white averages to linear 0.5.
-        let rgba = [0, 0, 0, 255, 255, 255, 255, 255, 255, 255, 255, 255, 0, 0, 0, 255];
+        let rgba = [
+            0, 0, 0, 255, 255, 255, 255, 255, 255, 255, 255, 255, 0, 0, 0, 255,
+        ];
         let t = Texture::from_rgba8(2, 2, &rgba, ColorSpace::Srgb).expect("texture");
         assert_eq!(t.levels().len(), 2);
         let top = t.levels()[1].texels[0];
@@ -457,7 +471,11 @@ mod tests {
         assert!((red(MinFilter::LinearMipmapLinear, 1.25) - 1.25).abs() < 1e-6);
         assert_eq!(red(MinFilter::LinearMipmapLinear, 10.0), 3.0);
         assert_eq!(red(MinFilter::Linear, 2.0), 0.0, "no mipmaps: level 0");
-        assert_eq!(red(MinFilter::LinearMipmapLinear, -1.0), 0.0, "magnified: level 0");
+        assert_eq!(
+            red(MinFilter::LinearMipmapLinear, -1.0),
+            0.0,
+            "magnified: level 0"
+        );
         // λ = log2 of the larger footprint in texels.
         assert!((t.lod(Vec2::new(0.5, 0.0), Vec2::new(0.0, 0.125)) - 2.0).abs() < 1e-6);
     }
