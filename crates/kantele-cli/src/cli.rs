@@ -253,8 +253,8 @@ Metrics per pair (a, b):
   coverage: share of pixels covered (depth < 1) in exactly one of the two images
   colour:   largest and mean absolute difference of the 8-bit sRGB RGB channels, all pixels
   depth:    largest and mean absolute window-depth difference over pixels covered by both
-Difference image: grey = largest channel difference x16; magenta = covered only in a,
-cyan = covered only in b. With more than two backends it is named <stem>-<a>-vs-<b>-diff.png.
+Difference image: grey = largest channel difference x8; red = covered only in a,
+green = covered only in b. With more than two backends it is named <stem>-<a>-vs-<b>-diff.png.
 Exit status: 1 when a tolerance is broken (each broken one is named on stderr), 2 on errors.";
 
 /// `kantele view`.

@@ -9,7 +9,7 @@ use serde_json::json;
 
 use crate::backends::make_backend;
 use crate::cli::CompareArgs;
-use crate::compare::{compare_buffers, diff_image, Tolerances};
+use crate::compare::{violations, Tolerances};
 use crate::output::write_png_rgba8;
 use crate::scenes::{self, Warnings};
 
@@ -75,31 +75,28 @@ pub fn run(args: &CompareArgs) -> Result<bool> {
         for b in backends.iter_mut() {
             b.load(scene.clone()).map_err(|e| anyhow!("{label}: {e}"))?;
             let frame = render(b.as_mut(), &view, &label)?;
-            let rgba = frame.to_rgba8(true);
             if let Some(dir) = &args.out {
                 let p = dir.join(format!("{stem}-{}.png", b.name()));
-                write_png_rgba8(&p, frame.width, frame.height, &rgba)?;
+                write_png_rgba8(&p, frame.width, frame.height, &frame.to_rgba8(true))?;
             }
-            frames.push((b.name().to_string(), frame, rgba));
+            frames.push((b.name().to_string(), frame));
         }
-        let pixels = view.width as usize * view.height as usize;
         for i in 0..frames.len() {
             for j in i + 1..frames.len() {
-                let (na, fa, ra) = &frames[i];
-                let (nb, fb, rb) = &frames[j];
-                let m = compare_buffers(pixels, ra, &fa.depth, rb, &fb.depth)
-                    .map_err(|e| anyhow!("{label}: {e}"))?;
+                let (na, fa) = &frames[i];
+                let (nb, fb) = &frames[j];
+                let m = kantele::compare::compare(fa, fb, None, u8::MAX)
+                    .ok_or_else(|| anyhow!("{label}: {na} and {nb} frames differ in size"))?;
                 if let Some(dir) = &args.out {
                     let name = if frames.len() == 2 {
                         format!("{stem}-diff.png")
                     } else {
                         format!("{stem}-{na}-vs-{nb}-diff.png")
                     };
-                    let d = diff_image(pixels, ra, &fa.depth, rb, &fb.depth)
-                        .map_err(|e| anyhow!("{label}: {e}"))?;
-                    write_png_rgba8(&Path::new(dir).join(name), view.width, view.height, &d)?;
+                    let path = Path::new(dir).join(name);
+                    write_png_rgba8(&path, view.width, view.height, &m.difference_image)?;
                 }
-                let violations = m.violations(&tol);
+                let violations = violations(&m, &tol);
                 passed &= violations.is_empty();
                 for v in &violations {
                     eprintln!("kantele: error: {label}: {na} vs {nb}: {v}");
@@ -110,9 +107,8 @@ pub fn run(args: &CompareArgs) -> Result<bool> {
                         json!({
                             "scene": stem, "source": loaded.info.source, "a": na, "b": nb,
                             "width": view.width, "height": view.height,
-                            "coverage_mismatches": m.coverage_mismatches, "coverage_diff": m.coverage_diff,
+                            "coverage_mismatches": m.coverage_mismatches, "coverage_diff": m.coverage_mismatch_fraction(),
                             "max_color_diff": m.max_color_diff, "mean_color_diff": m.mean_color_diff,
-                            "both_covered": m.both_covered,
                             "max_depth_diff": m.max_depth_diff, "mean_depth_diff": m.mean_depth_diff,
                             "passed": violations.is_empty(), "violations": violations,
                         })
@@ -123,7 +119,7 @@ pub fn run(args: &CompareArgs) -> Result<bool> {
                         stem,
                         na,
                         nb,
-                        m.coverage_diff * 100.0,
+                        m.coverage_mismatch_fraction() * 100.0,
                         m.max_color_diff,
                         m.mean_color_diff,
                         m.max_depth_diff,
