@@ -120,6 +120,49 @@ fn print_table(rows: &[Row], ratios: bool) {
     }
 }
 
+/// With several backends: one row per scene, a median column per backend, and each backend's
+/// ratio to the first (the layout of the thesis' comparison tables).
+fn print_side_by_side(rows: &[Row], backends: &[String]) {
+    println!();
+    for name in backends {
+        if let Some(r) = rows.iter().find(|r| &r.backend == name && r.result.is_ok()) {
+            println!("{name}: {} ({} threads)", r.renderer, r.threads);
+        }
+    }
+    let mut header = format!(
+        "{:<24} {:>11} {:>10} {:>6}",
+        "scene", "size", "triangles", "draws"
+    );
+    for name in backends {
+        header.push_str(&format!(" {:>10}", format!("{name} ms")));
+    }
+    for name in &backends[1..] {
+        header.push_str(&format!(" {:>10}", format!("{name}/{}", backends[0])));
+    }
+    println!("{header}");
+    for scene_rows in rows.chunks(backends.len()) {
+        let first = &scene_rows[0];
+        let size = format!("{}x{}", first.width, first.height);
+        let mut line = format!(
+            "{:<24} {:>11} {:>10} {:>6}",
+            first.scene, size, first.triangles, first.draws
+        );
+        for r in scene_rows {
+            match &r.result {
+                Ok(t) => line.push_str(&format!(" {:>10.2}", t.median)),
+                Err(_) => line.push_str(&format!(" {:>10}", "-")),
+            }
+        }
+        for r in &scene_rows[1..] {
+            match r.ratio {
+                Some(x) => line.push_str(&format!(" {x:>10.2}")),
+                None => line.push_str(&format!(" {:>10}", "-")),
+            }
+        }
+        println!("{line}");
+    }
+}
+
 /// Runs `kantele bench`.
 pub fn run(args: &BenchArgs) -> Result<()> {
     let inputs = scenes::inputs(&args.input)?;
@@ -218,6 +261,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
     }
     if !args.json {
         print_table(&rows, several);
+        if several {
+            let names: Vec<String> = backends.iter().map(|(n, _)| n.clone()).collect();
+            print_side_by_side(&rows, &names);
+        }
     }
     Ok(())
 }

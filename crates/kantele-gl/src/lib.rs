@@ -478,29 +478,21 @@ impl Backend for GlBackend {
         NAME
     }
 
-    /// The `GL_RENDERER` string; for llvmpipe followed by its rasterizer thread count
-    /// (`LP_NUM_THREADS`, else the number of cores, as Mesa chooses it).
+    /// The `GL_RENDERER` string, e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`.
     fn renderer(&self) -> String {
-        if self.renderer.starts_with("llvmpipe") {
-            let (threads, from) = match std::env::var("LP_NUM_THREADS")
-                .ok()
-                .and_then(|v| v.trim().parse::<usize>().ok())
-            {
-                Some(n) => (n, "LP_NUM_THREADS"),
-                None => (
-                    std::thread::available_parallelism().map_or(1, |n| n.get()),
-                    "cores",
-                ),
-            };
-            format!("{} [{threads} threads, {from}]", self.renderer)
-        } else {
-            self.renderer.clone()
-        }
+        self.renderer.clone()
     }
 
-    /// 1: the driver renders (llvmpipe's own threads are reported by [`Backend::renderer`]).
+    /// For llvmpipe, its rasterizer threads (`LP_NUM_THREADS`, else the number of cores, as
+    /// Mesa chooses them); 1 for a GPU driver.
     fn threads(&self) -> usize {
-        1
+        if !self.renderer.starts_with("llvmpipe") {
+            return 1;
+        }
+        std::env::var("LP_NUM_THREADS")
+            .ok()
+            .and_then(|v| v.trim().parse::<usize>().ok())
+            .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
     }
 
     fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError> {

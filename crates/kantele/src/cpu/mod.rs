@@ -84,11 +84,7 @@ impl Backend for CpuBackend {
     }
 
     fn renderer(&self) -> String {
-        format!(
-            "kantele cpu ({}, {} threads)",
-            self.renderer.strategy(),
-            self.renderer.threads()
-        )
+        format!("kantele cpu ({})", self.renderer.strategy())
     }
 
     fn threads(&self) -> usize {
