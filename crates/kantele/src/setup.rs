@@ -152,6 +152,9 @@ pub struct TriangleSetup {
     pub inv_w: [f32; 3],
     /// `1 / area2` as `f32`.
     pub inv_area2: f32,
+    /// `(a_i, b_i) / area2` for edges 1 and 2: `λ_i` at a sample `d` sub-pixel units from
+    /// vertex 0 is `g_i · d` (edges 1 and 2 pass through vertex 0, so there is no constant).
+    pub bary_gradient: [[f32; 2]; 2],
     /// Index of the draw in the frame.
     pub draw: u32,
     /// Index of the source triangle within its draw.
@@ -294,6 +297,10 @@ pub fn setup_triangle(
         depth,
         inv_w,
         inv_area2: 1.0 / area2 as f32,
+        bary_gradient: [
+            [edges[1].a as f32 / area2 as f32, edges[1].b as f32 / area2 as f32],
+            [edges[2].a as f32 / area2 as f32, edges[2].b as f32 / area2 as f32],
+        ],
         draw: 0,
         primitive_id: 0,
         front_facing,
@@ -308,14 +315,18 @@ impl TriangleSetup {
         self.edges.iter().all(|e| e.biased_at_pixel(x, y) >= 0)
     }
 
-    /// Screen-space barycentric weights `λ_i = E_i / area2` at the centre of pixel `(x, y)`.
+    /// Screen-space barycentric weights `λ_i = E_i / area2` at the centre of pixel `(x, y)`,
+    /// evaluated from scratch in a fixed order of `f32` operations (no accumulated stepping, no
+    /// fused multiply-add), so every traversal and every backend gets the same bits:
+    /// `d = centre − vertex 0` (exact), `λ1 = g1·d`, `λ2 = g2·d`, `λ0 = 1 − λ1 − λ2`.
     #[inline]
     pub fn barycentrics(&self, x: i32, y: i32) -> [f32; 3] {
-        [
-            self.edges[0].at_pixel(x, y) as f32 * self.inv_area2,
-            self.edges[1].at_pixel(x, y) as f32 * self.inv_area2,
-            self.edges[2].at_pixel(x, y) as f32 * self.inv_area2,
-        ]
+        let dx = (pixel_center(x as i64) - self.pos_subpixel[0][0]) as f32;
+        let dy = (pixel_center(y as i64) - self.pos_subpixel[0][1]) as f32;
+        let g = &self.bary_gradient;
+        let l1 = g[0][0] * dx + g[0][1] * dy;
+        let l2 = g[1][0] * dx + g[1][1] * dy;
+        [1.0 - l1 - l2, l1, l2]
     }
 
     /// Window depth at the given barycentrics (affine in screen space).

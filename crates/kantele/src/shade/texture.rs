@@ -309,6 +309,10 @@ impl Wrap {
     /// Maps an integer texel coordinate into `0..size` (OpenGL 4.6 §8.14.2, table 8.20).
     #[inline]
     fn apply(self, i: i32, size: i32) -> i32 {
+        // Inside the texture every mode is the identity (the common case, no division).
+        if (i as u32) < size as u32 {
+            return i;
+        }
         match self {
             Wrap::Repeat => i.rem_euclid(size),
             Wrap::ClampToEdge => i.clamp(0, size - 1),
@@ -320,6 +324,20 @@ impl Wrap {
                     2 * size - 1 - period
                 }
             }
+        }
+    }
+}
+
+impl Wrap {
+    /// Moves a coordinate into the first period of a repeating mode ([0, 1) for REPEAT,
+    /// [0, 2) for MIRRORED_REPEAT) so texel indices stay small and mostly inside the texture;
+    /// CLAMP_TO_EDGE is left alone.
+    #[inline]
+    fn reduce(self, t: f32) -> f32 {
+        match self {
+            Wrap::Repeat => t - t.floor(),
+            Wrap::MirroredRepeat => t - 2.0 * (t * 0.5).floor(),
+            Wrap::ClampToEdge => t,
         }
     }
 }
@@ -342,8 +360,8 @@ pub struct Sampler {
 fn sample_level(level: &MipLevel, sampler: &Sampler, filter: Filter, uv: Vec2) -> Vec4 {
     let w = level.width as i32;
     let h = level.height as i32;
-    let u = uv.x * w as f32;
-    let v = uv.y * h as f32;
+    let u = sampler.wrap_s.reduce(uv.x) * w as f32;
+    let v = sampler.wrap_t.reduce(uv.y) * h as f32;
     match filter {
         Filter::Nearest => {
             let i = sampler.wrap_s.apply(floor_to_i32(u), w);
