@@ -221,7 +221,7 @@ pub struct CompareArgs {
         value_name = "LIST"
     )]
     pub backends: Vec<BackendKind>,
-    /// Write DIR/<stem>-<backend>.png and DIR/<stem>-diff.png.
+    /// Write `DIR/<stem>-<backend>.png` and `DIR/<stem>-diff.png`.
     #[arg(long, value_name = "DIR")]
     pub out: Option<PathBuf>,
     /// Largest share of pixels (0..1) whose coverage may differ.

@@ -1,4 +1,21 @@
 //! The `kantele` command: render, inspect, benchmark, compare and view scenes.
+//!
+//! Scenes are glTF 2.0 / OBJ files (loaded by `kantele-io`) or built-ins (`--builtin cube`),
+//! drawn by the rules of the reference scenes. Backends are `cpu` (Kantele) and `gl` (the
+//! OpenGL reference, `kantele-gl`).
+//!
+//! - `render` writes PNG/EXR colour and, optionally, depth (PFM/EXR), normal and id images,
+//!   plus a JSON sidecar ([`render_cmd`]).
+//! - `info` describes a scene ([`info`]).
+//! - `bench` times frames on one or more backends, giving the median after warm-up
+//!   ([`bench`](mod@bench)).
+//! - `compare` renders with several backends and measures how far the pictures differ, exiting
+//!   with 1 when a tolerance is broken ([`compare_cmd`]).
+//! - `view` opens a window with an orbit camera (winit + softbuffer, [`view`]).
+//!
+//! The argument definitions are in [`cli`], and backend construction is in [`backends`].
+//! Errors are printed as one line, `kantele: error: …`, on stderr and exit with status 2. This
+//! crate is the only place where Kantele talks to people. The libraries return typed errors.
 
 mod backends;
 mod bench;

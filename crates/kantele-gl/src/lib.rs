@@ -3,6 +3,26 @@
 //! created headlessly through EGL, so that Kantele's pictures and timings can be compared with a
 //! real GL driver (Mesa's llvmpipe on CI, a GPU driver where there is one).
 //!
+//! The entry point is [`GlBackend`]: [`GlBackend::new`] creates the context (or returns an
+//! error when no EGL/OpenGL is available), and the [`Backend`] trait does the rest: `load` a
+//! scene once, `render` a [`kantele::backend::FrameView`], then `read_frame`. The
+//! `unsafe` GL and EGL calls of the workspace live in this crate. The core `kantele` crate
+//! forbids `unsafe`.
+//!
+//! ```no_run
+//! use std::sync::Arc;
+//! use kantele::backend::{Backend, FrameView};
+//! use kantele::scene::Scene;
+//!
+//! # fn scene() -> Scene { unimplemented!() }
+//! let scene = Arc::new(scene()); // e.g. from kantele-io
+//! let mut gl = kantele_gl::GlBackend::new()?;
+//! gl.load(scene.clone())?;
+//! gl.render(&FrameView::of_scene(&scene))?;
+//! let image = gl.read_frame()?; // linear RGBA + depth, row 0 = top
+//! # Ok::<(), kantele::RenderError>(())
+//! ```
+//!
 //! # How the rules map onto GL
 //!
 //! - **Orientation.** The projection is y-flipped (`diag(1, −1, 1, 1) · projection`), so window

@@ -4,6 +4,32 @@
 //! The rules (draw order, camera, light, extras, materials) are those of
 //! `shared/scenes/README.md`; the glTF loader follows them exactly, the OBJ loader and the
 //! built-in scenes fill the same structure with sensible defaults.
+//!
+//! # Entry points
+//!
+//! - [`load_scene`] loads a file, choosing the format by extension. Malformed input of any kind
+//!   gives a [`LoadError`] that names the file, never a panic.
+//! - [`builtin_scenes`] lists the built-in scenes (`cube`, `teapot`, `ground`, `pixel-edges`),
+//!   generated in code with no asset files, and [`builtin_scene`] builds one by name.
+//! - Each call returns a [`LoadedScene`]: the [`Scene`], ready for any
+//!   [`Backend`](kantele::backend::Backend), and a [`SceneInfo`] with facts and warnings about
+//!   the source.
+//! - [`mesh_util`] holds helpers shared by the loaders (flat normals, strips and fans to lists,
+//!   a framing camera).
+//!
+//! ```no_run
+//! use std::sync::Arc;
+//! use kantele::backend::{Backend, FrameView};
+//! use kantele::cpu::{CpuBackend, CpuOptions};
+//!
+//! let loaded = kantele_io::builtin_scene("cube")?;
+//! let scene = Arc::new(loaded.scene);
+//! let mut cpu = CpuBackend::new(CpuOptions::default())?;
+//! cpu.load(scene.clone())?;
+//! cpu.render(&FrameView::of_scene(&scene))?;
+//! let image = cpu.read_frame()?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
 #![warn(missing_docs)]
 
 use std::path::{Path, PathBuf};

@@ -298,8 +298,14 @@ pub fn setup_triangle(
         inv_w,
         inv_area2: 1.0 / area2 as f32,
         bary_gradient: [
-            [edges[1].a as f32 / area2 as f32, edges[1].b as f32 / area2 as f32],
-            [edges[2].a as f32 / area2 as f32, edges[2].b as f32 / area2 as f32],
+            [
+                edges[1].a as f32 / area2 as f32,
+                edges[1].b as f32 / area2 as f32,
+            ],
+            [
+                edges[2].a as f32 / area2 as f32,
+                edges[2].b as f32 / area2 as f32,
+            ],
         ],
         draw: 0,
         primitive_id: 0,

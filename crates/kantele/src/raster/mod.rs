@@ -22,8 +22,8 @@ pub enum Strategy {
     Incremental,
     /// 8 × 8 blocks classified empty / partial / full by their corners.
     Block,
-    /// Blocks when the bounding box's aspect ratio is within 0.4–1.6 and it spans at least a
-    /// block, incremental otherwise (the paper's adaptive model).
+    /// Blocks when the bounding box's aspect ratio is within 0.4–1.6 and it spans at least
+    /// [`ADAPTIVE_MIN_SIDE`] pixels, incremental otherwise (the paper's adaptive model).
     Adaptive,
     /// Adaptive, with block rows traversed outwards from a start block halfway between the
     /// previous row's bounds (the paper's bisector traversal).
@@ -107,12 +107,19 @@ pub fn rasterize(
     }
 }
 
-/// The paper's adaptive rule: blocks for boxes with aspect 0.4–1.6 spanning at least a block.
+/// Smallest bounding-box side (pixels, in x or y) for which the adaptive rule uses blocks. The
+/// paper says one block; measured here (`benches/traversal.rs`, BENCHMARKS.md) triangles of
+/// about one block straddle up to four blocks and scan twice as slowly as incrementally, so
+/// blocks start at two.
+pub const ADAPTIVE_MIN_SIDE: i32 = 2 * BLOCK_SIZE as i32;
+
+/// The paper's adaptive rule: blocks for boxes with aspect 0.4–1.6 that are large enough
+/// ([`ADAPTIVE_MIN_SIDE`]).
 #[inline]
 pub fn prefers_blocks(tri: &TriangleSetup) -> bool {
     let w = tri.bbox.width();
     let h = tri.bbox.height();
-    if w < BLOCK_SIZE as i32 && h < BLOCK_SIZE as i32 {
+    if w < ADAPTIVE_MIN_SIDE && h < ADAPTIVE_MIN_SIDE {
         return false;
     }
     // 0.4 ≤ w / h ≤ 1.6, in integers: 2h ≤ 5w and 5w ≤ 8h.
