@@ -39,7 +39,7 @@ pub struct SceneArgs {
     /// Scene files (.gltf, .glb, .obj).
     #[arg(value_name = "SCENE")]
     pub scenes: Vec<PathBuf>,
-    /// A built-in scene (cube, teapot, ground); may be repeated. Built-ins come after the files.
+    /// A built-in scene (cube, teapot, ground, pixel-edges); may be repeated. Built-ins come after the files.
     #[arg(long = "builtin", value_name = "NAME")]
     pub builtins: Vec<String>,
 }
