@@ -372,3 +372,47 @@ fn reference_scene_round_trips_through_gltf_with_external_files() {
     let b = load(&path);
     assert_same_scene(&a.scene, &b.scene);
 }
+
+/// Textures are upright: the glTF convention puts texcoord (0, 0) at the image's first (top)
+/// row. The quad's top-left vertex has uv (0, 0) and the 2 × 2 image is red, green / blue,
+/// white, so the rendered quad must show red top-left, green top-right, blue bottom-left.
+#[test]
+fn textures_render_upright_and_unmirrored() {
+    use kantele::backend::{Backend, FrameView};
+    let dir = temp_dir("upright");
+    let path = dir.join("quad.gltf");
+    textured_quad().write_gltf_embedded(&path);
+    let scene = std::sync::Arc::new(load(&path).scene);
+    let mut cpu = kantele::cpu::CpuBackend::new(Default::default()).expect("cpu");
+    cpu.load(scene.clone()).expect("load");
+    let view = FrameView::of_scene(&scene);
+    cpu.render(&view).expect("render");
+    let frame = cpu.read_frame().expect("read");
+    let at = |x: u32, y: u32| frame.color[(y * frame.width + x) as usize];
+    let dominant = |c: [f32; 4]| (0..3).max_by(|&a, &b| c[a].total_cmp(&c[b])).unwrap_or(0);
+    // Quadrant centres of the 320 × 240 image; the quad fills the view vertically and spans
+    // the texel boundary u = 0.5 near the middle column.
+    assert_eq!(
+        dominant(at(80, 60)),
+        0,
+        "top-left should be red: {:?}",
+        at(80, 60)
+    );
+    assert_eq!(
+        dominant(at(240, 60)),
+        1,
+        "top-right should be green: {:?}",
+        at(240, 60)
+    );
+    assert_eq!(
+        dominant(at(80, 180)),
+        2,
+        "bottom-left should be blue: {:?}",
+        at(80, 180)
+    );
+    let white = at(240, 180);
+    assert!(
+        white[0] > 0.0 && white[1] > 0.0 && white[2] > 0.0,
+        "bottom-right should be white × factor: {white:?}"
+    );
+}
