@@ -190,24 +190,24 @@ impl Framebuffer {
         self.read(|t, i| t.depth[i])
     }
 
-    /// Colour of one pixel (`None` outside the target).
-    pub fn pixel(&self, x: u32, y: u32) -> Option<Vec4> {
+    /// The tile and the index within it of pixel `(x, y)`, if it lies on the target.
+    fn locate(&self, x: u32, y: u32) -> Option<(&TileBuffer, usize)> {
         if x >= self.grid.width || y >= self.grid.height {
             return None;
         }
         let tile =
             (y >> TILE_LOG2) as usize * self.grid.tiles_x as usize + (x >> TILE_LOG2) as usize;
-        Some(self.tiles[tile].color[TileBuffer::index(x as i32, y as i32)])
+        Some((&self.tiles[tile], TileBuffer::index(x as i32, y as i32)))
+    }
+
+    /// Colour of one pixel (`None` outside the target).
+    pub fn pixel(&self, x: u32, y: u32) -> Option<Vec4> {
+        self.locate(x, y).map(|(tile, i)| tile.color[i])
     }
 
     /// Depth of one pixel (`None` outside the target).
     pub fn depth_at(&self, x: u32, y: u32) -> Option<f32> {
-        if x >= self.grid.width || y >= self.grid.height {
-            return None;
-        }
-        let tile =
-            (y >> TILE_LOG2) as usize * self.grid.tiles_x as usize + (x >> TILE_LOG2) as usize;
-        Some(self.tiles[tile].depth[TileBuffer::index(x as i32, y as i32)])
+        self.locate(x, y).map(|(tile, i)| tile.depth[i])
     }
 }
 

@@ -23,6 +23,24 @@ fn attribute_shader(mvp: Mat4) -> impl kantele::pipeline::Shader<Vertex = Vtx> {
     )
 }
 
+/// Two triangles covering NDC [−1, 1]² at clip z = `z` (w = 1), attribute `(c, c)`.
+fn quad(z: f32, c: f32) -> Vec<Vtx> {
+    quad_with(z, Vec2::splat(c))
+}
+
+/// The same with attribute `a`.
+fn quad_with(z: f32, a: Vec2) -> Vec<Vtx> {
+    let v = |x: f32, y: f32| (Vec3::new(x, y, z), a);
+    vec![
+        v(-1.0, -1.0),
+        v(1.0, -1.0),
+        v(1.0, 1.0),
+        v(-1.0, -1.0),
+        v(1.0, 1.0),
+        v(-1.0, 1.0),
+    ]
+}
+
 fn no_cull() -> RenderState {
     RenderState {
         cull: CullMode::None,
@@ -206,17 +224,6 @@ fn level_of_detail_grows_along_a_receding_plane_as_the_analytic_footprint() {
 fn depth_functions_decide_which_of_two_quads_is_seen() {
     // A near quad (depth 0.25) then a far one (0.75), both full-screen; the second draw uses
     // the function under test.
-    let quad = |z: f32, c: f32| -> Vec<Vtx> {
-        let v = |x: f32, y: f32| (Vec3::new(x, y, z), Vec2::new(c, c));
-        vec![
-            v(-1.0, -1.0),
-            v(1.0, -1.0),
-            v(1.0, 1.0),
-            v(-1.0, -1.0),
-            v(1.0, 1.0),
-            v(-1.0, 1.0),
-        ]
-    };
     let shader = attribute_shader(Mat4::IDENTITY);
     let first = quad(-0.5, 0.2);
     let cases = [
@@ -256,17 +263,6 @@ fn depth_functions_decide_which_of_two_quads_is_seen() {
 
 #[test]
 fn depth_test_off_and_write_off_behave_independently() {
-    let quad = |z: f32, c: f32| -> Vec<Vtx> {
-        let v = |x: f32, y: f32| (Vec3::new(x, y, z), Vec2::new(c, c));
-        vec![
-            v(-1.0, -1.0),
-            v(1.0, -1.0),
-            v(1.0, 1.0),
-            v(-1.0, -1.0),
-            v(1.0, 1.0),
-            v(-1.0, 1.0),
-        ]
-    };
     let shader = attribute_shader(Mat4::IDENTITY);
     let mut renderer = Renderer::new(8, 8, RendererOptions::default()).expect("renderer");
     let near = quad(-0.5, 0.3);
@@ -317,20 +313,9 @@ fn fragments_outside_the_depth_range_are_discarded() {
 fn blending_and_back_to_front_sorting() {
     // Two overlapping half-transparent quads submitted front first; with sorting the back one
     // is drawn first, so the front colour dominates.
-    let quad = |z: f32, c: f32| -> Vec<Vtx> {
-        let v = |x: f32, y: f32| (Vec3::new(x, y, z), Vec2::new(c, 0.5));
-        vec![
-            v(-1.0, -1.0),
-            v(1.0, -1.0),
-            v(1.0, 1.0),
-            v(-1.0, -1.0),
-            v(1.0, 1.0),
-            v(-1.0, 1.0),
-        ]
-    };
     let view_proj = perspective(1.5, 1.0, 0.1, 10.0);
-    let mut vertices = quad(-1.0, 1.0); // front, red = 1
-    vertices.extend(quad(-2.0, 0.0)); // back, red = 0
+    let mut vertices = quad_with(-1.0, Vec2::new(1.0, 0.5)); // front, red = 1, alpha 0.5
+    vertices.extend(quad_with(-2.0, Vec2::new(0.0, 0.5))); // back, red = 0
     let shader = FnShader::new(
         2,
         move |v: &Vtx, out: &mut [f32]| {
