@@ -427,6 +427,12 @@ impl GlBackend {
                 if gpu_mesh.index_count == 0 {
                     continue;
                 }
+                // The y-flip mirrors the winding: front (CCW in NDC) is CW in GL's window; a
+                // mirroring model matrix flips it once more.
+                gl.front_face(match draw.front_face() {
+                    kantele::setup::FrontFace::Ccw => glow::CW,
+                    kantele::setup::FrontFace::Cw => glow::CCW,
+                });
                 if material.double_sided {
                     gl.disable(glow::CULL_FACE);
                 } else {

@@ -13,6 +13,14 @@ pub enum RenderError {
         /// Requested height in pixels.
         height: u32,
     },
+    /// Memory for a render target or texture could not be reserved.
+    #[error("out of memory: cannot reserve {bytes} bytes for {what}")]
+    OutOfMemory {
+        /// What was being allocated.
+        what: &'static str,
+        /// How much was asked for.
+        bytes: usize,
+    },
     /// A texture is empty or larger than [`crate::shade::texture::MAX_TEXTURE_SIZE`].
     #[error("invalid texture size {width}x{height}")]
     InvalidTextureSize {

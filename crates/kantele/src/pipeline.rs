@@ -261,7 +261,7 @@ impl Renderer {
                 message: format!("cannot start worker threads: {e}"),
             })?;
         Ok(Self {
-            framebuffer: Framebuffer::new(width, height),
+            framebuffer: Framebuffer::new(width, height)?,
             pool,
             strategy: options.strategy,
             bins: TileBins::default(),
@@ -272,7 +272,7 @@ impl Renderer {
     pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
         check_target_size(width, height)?;
         if (width, height) != (self.framebuffer.width(), self.framebuffer.height()) {
-            self.framebuffer = Framebuffer::new(width, height);
+            self.framebuffer = Framebuffer::new(width, height)?;
         }
         Ok(())
     }

@@ -7,6 +7,7 @@
 
 use glam::Vec4;
 
+use crate::error::RenderError;
 use crate::fixed::{TILE_LOG2, TILE_PIXELS, TILE_SIZE};
 use crate::raster::bin::TileGrid;
 
@@ -91,11 +92,11 @@ pub struct TileBuffer {
 }
 
 impl TileBuffer {
-    fn new() -> Self {
-        Self {
-            color: vec![Vec4::ZERO; TILE_PIXELS],
-            depth: vec![1.0; TILE_PIXELS],
-        }
+    fn new() -> Result<Self, RenderError> {
+        Ok(Self {
+            color: filled_vec(TILE_PIXELS, Vec4::ZERO)?,
+            depth: filled_vec(TILE_PIXELS, 1.0)?,
+        })
     }
 
     /// Index of absolute pixel `(x, y)` within the tile (the tile's origin is a multiple of
@@ -105,6 +106,18 @@ impl TileBuffer {
         let mask = TILE_SIZE as i32 - 1;
         (((y & mask) << TILE_LOG2) | (x & mask)) as usize
     }
+}
+
+/// A vector of `n` copies of `value`, or an error instead of an abort when memory runs out.
+fn filled_vec<T: Clone>(n: usize, value: T) -> Result<Vec<T>, RenderError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| RenderError::OutOfMemory {
+            what: "render target",
+            bytes: n.saturating_mul(std::mem::size_of::<T>()),
+        })?;
+    v.resize(n, value);
+    Ok(v)
 }
 
 /// A colour + depth target stored as tiles.
@@ -117,12 +130,19 @@ pub struct Framebuffer {
 impl Framebuffer {
     /// A target of `width × height` (sizes checked by the caller), cleared to transparent black
     /// and depth 1.
-    pub(crate) fn new(width: u32, height: u32) -> Self {
+    pub(crate) fn new(width: u32, height: u32) -> Result<Self, RenderError> {
         let grid = TileGrid::new(width, height);
-        Self {
-            grid,
-            tiles: (0..grid.tile_count()).map(|_| TileBuffer::new()).collect(),
+        let mut tiles = Vec::new();
+        tiles
+            .try_reserve_exact(grid.tile_count())
+            .map_err(|_| RenderError::OutOfMemory {
+                what: "render target",
+                bytes: grid.tile_count() * std::mem::size_of::<TileBuffer>(),
+            })?;
+        for _ in 0..grid.tile_count() {
+            tiles.push(TileBuffer::new()?);
         }
+        Ok(Self { grid, tiles })
     }
 
     /// Width in pixels.
@@ -259,7 +279,7 @@ mod tests {
 
     #[test]
     fn framebuffer_reads_back_row_major() {
-        let mut fb = Framebuffer::new(70, 3);
+        let mut fb = Framebuffer::new(70, 3).expect("small target");
         fb.clear(Some(Vec4::ONE), Some(0.25));
         let c = fb.read_color();
         assert_eq!(c.len(), 210);

@@ -8,6 +8,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::camera;
 use crate::error::RenderError;
+use crate::setup::FrontFace;
 use crate::shade::texture::{Sampler, Texture};
 
 /// An indexed triangle list with the standard vertex attributes.
@@ -143,6 +144,18 @@ pub struct Draw {
     pub node_name: String,
     /// The node's index in the source file (instance id − 1 in id buffers).
     pub node_index: usize,
+}
+
+impl Draw {
+    /// Which winding is front for this draw: a model matrix with a negative determinant
+    /// mirrors the mesh, so its counter-clockwise faces appear clockwise (glTF 2.0 §3.7.4).
+    pub fn front_face(&self) -> FrontFace {
+        if self.model.determinant() < 0.0 {
+            FrontFace::Cw
+        } else {
+            FrontFace::Ccw
+        }
+    }
 }
 
 /// A perspective camera: placement plus glTF-style projection parameters.

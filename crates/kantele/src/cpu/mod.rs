@@ -6,7 +6,7 @@ use std::sync::Arc;
 use crate::backend::{Backend, FrameImage, FrameView, Pass};
 use crate::error::RenderError;
 use crate::material::{Lighting, MaterialShader, StandardVertex};
-use crate::pipeline::{Indices, Renderer, RendererOptions};
+use crate::pipeline::{Indices, RenderState, Renderer, RendererOptions};
 use crate::raster::Strategy;
 use crate::scene::{Mesh, Scene};
 use crate::stats::FrameStats;
@@ -136,12 +136,11 @@ impl Backend for CpuBackend {
         let mut frame = self.renderer.begin_frame(Some(clear), Some(1.0));
         for (draw, shader) in scene.draws.iter().zip(&shaders) {
             let mesh = &meshes[draw.mesh];
-            frame.draw(
-                shader,
-                &mesh.vertices,
-                Indices::U32(&mesh.indices),
-                shader.render_state(),
-            )?;
+            let state = RenderState {
+                front_face: draw.front_face(),
+                ..shader.render_state()
+            };
+            frame.draw(shader, &mesh.vertices, Indices::U32(&mesh.indices), state)?;
         }
         Ok(frame.end())
     }
@@ -154,5 +153,56 @@ impl Backend for CpuBackend {
             color: fb.read_color(),
             depth: fb.read_depth(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::backend::FrameView;
+    use crate::scene::{Draw, Material};
+    use glam::{Mat4, Vec3};
+
+    /// A single-sided quad facing the camera, drawn once plainly and once through a mirroring
+    /// model matrix: both must be visible (the mirror flips which winding is front).
+    #[test]
+    fn mirrored_draws_keep_their_front_faces() {
+        let quad = Mesh {
+            positions: vec![
+                Vec3::new(-0.5, -0.5, 0.0),
+                Vec3::new(0.5, -0.5, 0.0),
+                Vec3::new(0.5, 0.5, 0.0),
+                Vec3::new(-0.5, 0.5, 0.0),
+            ],
+            normals: Some(vec![Vec3::Z; 4]),
+            indices: vec![0, 1, 2, 0, 2, 3],
+            ..Mesh::default()
+        };
+        let covered = |model: Mat4| {
+            let scene = Scene {
+                meshes: vec![quad.clone()],
+                materials: vec![Material::default()],
+                draws: vec![Draw {
+                    mesh: 0,
+                    model,
+                    node_name: String::new(),
+                    node_index: 0,
+                }],
+                camera: crate::scene::Camera::framing(Vec3::ZERO, 1.0, Vec3::Z, 1.0),
+                resolution: (64, 64),
+                ..Scene::default()
+            };
+            let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu");
+            cpu.load(Arc::new(scene.clone())).expect("load");
+            let stats = cpu.render(&FrameView::of_scene(&scene)).expect("render");
+            (stats.fragments_shaded, stats.triangles_culled)
+        };
+        let plain = covered(Mat4::IDENTITY);
+        let mirrored = covered(Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)));
+        assert!(plain.0 > 500, "{plain:?}");
+        assert_eq!(
+            mirrored, plain,
+            "the mirrored quad must be drawn, not culled"
+        );
     }
 }
