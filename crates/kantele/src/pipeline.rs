@@ -413,20 +413,24 @@ impl<'a> Frame<'_, 'a> {
                     let mut counters = RasterCounters::default();
                     for &t in bin {
                         let tri = &geometry.triangles[t as usize];
+                        let draw = &draws[tri.draw as usize];
+                        // Early rejection: behind everything already in this tile.
+                        if draw.rejects_by_depth_bound() {
+                            let min_depth = tri.depth[0].min(tri.depth[1]).min(tri.depth[2]);
+                            let r = rect.intersect(&tri.bbox);
+                            if tile.occludes(min_depth, r.width() * r.height(), &rect) {
+                                counters.tile_rejected += 1;
+                                continue;
+                            }
+                        }
                         let attrs = geometry.attrs_of(t as usize, &draws);
-                        draws[tri.draw as usize].raster(
-                            tri,
-                            attrs,
-                            tile,
-                            rect,
-                            strategy,
-                            &mut counters,
-                        );
+                        draw.raster(tri, attrs, tile, rect, strategy, &mut counters);
                     }
                     counters
                 })
                 .reduce(RasterCounters::default, RasterCounters::sum);
             stats.fragments_covered = counters.covered;
+            stats.tiles_depth_rejected = counters.tile_rejected;
             stats.fragments_shaded = counters.shaded;
             stats.fragments_discarded = counters.discarded;
             stats.raster_time = raster_start.elapsed();
@@ -439,6 +443,7 @@ impl<'a> Frame<'_, 'a> {
 /// Fragment counters of one tile.
 #[derive(Clone, Copy, Debug, Default)]
 struct RasterCounters {
+    tile_rejected: u64,
     covered: u64,
     shaded: u64,
     discarded: u64,
@@ -447,6 +452,7 @@ struct RasterCounters {
 impl RasterCounters {
     fn sum(a: Self, b: Self) -> Self {
         Self {
+            tile_rejected: a.tile_rejected + b.tile_rejected,
             covered: a.covered + b.covered,
             shaded: a.shaded + b.shaded,
             discarded: a.discarded + b.discarded,
@@ -618,6 +624,10 @@ trait DrawJob: Sync {
     fn varying_count(&self) -> usize;
     fn triangle_count(&self) -> usize;
     fn shade_vertices(&self, first: usize, pos: &mut [Vec4], varyings: &mut [f32]);
+    /// Whether a triangle of this draw wholly behind a tile's depth bound can be skipped there:
+    /// the test is LESS or LEQUAL (its fragments would all fail, and shaders have no side
+    /// effects to miss).
+    fn rejects_by_depth_bound(&self) -> bool;
     fn sort_order(&self, shaded: &ShadedVertices) -> Option<Vec<u32>>;
     fn assemble(
         &self,
@@ -702,6 +712,14 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
             let out = &mut varyings[i * n..(i + 1) * n];
             *p = self.shader.vertex(&self.vertices[first + i], out);
         }
+    }
+
+    fn rejects_by_depth_bound(&self) -> bool {
+        self.state.depth_test
+            && matches!(
+                self.state.depth_func,
+                DepthFunc::Less | DepthFunc::LessEqual
+            )
     }
 
     fn sort_order(&self, shaded: &ShadedVertices) -> Option<Vec<u32>> {
@@ -843,7 +861,7 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
                 Some(color) => {
                     tile.color[index] = state.blend.blend(color, tile.color[index]);
                     if state.depth_write {
-                        tile.depth[index] = depth;
+                        tile.write_depth(index, depth);
                     }
                 }
             }

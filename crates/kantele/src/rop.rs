@@ -10,6 +10,7 @@ use glam::Vec4;
 use crate::error::RenderError;
 use crate::fixed::{TILE_LOG2, TILE_PIXELS, TILE_SIZE};
 use crate::raster::bin::TileGrid;
+use crate::setup::PixelRect;
 
 /// Depth comparison: a fragment passes when `fragment_depth OP stored_depth` holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
@@ -89,14 +90,66 @@ pub struct TileBuffer {
     pub color: Vec<Vec4>,
     /// Window depth.
     pub depth: Vec<f32>,
+    /// An upper bound of every value in `depth` (kept by every depth write).
+    depth_bound: f32,
+    /// Whether `depth_bound` is the exact maximum (false after writes until recomputed).
+    depth_bound_exact: bool,
 }
+
+/// How much a fragment's interpolated depth may fall below its triangle's smallest vertex depth
+/// through `f32` rounding of the barycentric sum (a few ulps of values ≤ 1, with a wide margin).
+const DEPTH_BOUND_SLACK: f32 = 1e-5;
+
+/// Least triangle ∩ tile area (pixels) for which a stale depth bound is recomputed: scanning
+/// 4096 depths pays off only when the triangle could cover many pixels.
+const DEPTH_BOUND_REFRESH_AREA: i32 = 1024;
 
 impl TileBuffer {
     fn new() -> Result<Self, RenderError> {
         Ok(Self {
             color: filled_vec(TILE_PIXELS, Vec4::ZERO)?,
             depth: filled_vec(TILE_PIXELS, 1.0)?,
+            depth_bound: 1.0,
+            depth_bound_exact: true,
         })
+    }
+
+    /// Writes a depth value, keeping the tile's bound valid.
+    #[inline]
+    pub fn write_depth(&mut self, index: usize, depth: f32) {
+        self.depth[index] = depth;
+        self.depth_bound = self.depth_bound.max(depth);
+        self.depth_bound_exact = false;
+    }
+
+    /// Whether every fragment of a triangle whose vertex depths are at least `min_depth` would
+    /// fail a LESS or LEQUAL test in this tile (so the triangle can be skipped here without
+    /// changing the picture). `tile` is the tile's rectangle on the target and `area` the area
+    /// of the triangle's box within it, used to decide whether a stale bound is worth
+    /// recomputing.
+    #[inline]
+    pub fn occludes(&mut self, min_depth: f32, area: i32, tile: &PixelRect) -> bool {
+        let min_depth = min_depth - DEPTH_BOUND_SLACK;
+        if min_depth > self.depth_bound {
+            return true;
+        }
+        let tile_area = tile.width() * tile.height();
+        if self.depth_bound_exact || area < DEPTH_BOUND_REFRESH_AREA.min(tile_area / 4) {
+            return false;
+        }
+        // Only pixels on the target: those past its edge keep the clear value forever.
+        let mut bound = f32::NEG_INFINITY;
+        for y in tile.y0..tile.y1 {
+            let row = Self::index(tile.x0, y);
+            let width = tile.width() as usize;
+            bound = self.depth[row..row + width]
+                .iter()
+                .copied()
+                .fold(bound, f32::max);
+        }
+        self.depth_bound = bound;
+        self.depth_bound_exact = true;
+        min_depth > self.depth_bound
     }
 
     /// Index of absolute pixel `(x, y)` within the tile (the tile's origin is a multiple of
@@ -173,6 +226,8 @@ impl Framebuffer {
             }
             if let Some(d) = depth {
                 tile.depth.fill(d);
+                tile.depth_bound = d;
+                tile.depth_bound_exact = true;
             }
         });
     }

@@ -23,7 +23,10 @@ pub struct FrameStats {
     pub triangles_binned: u64,
     /// Triangle references written to tile bins (a triangle counts once per tile it touches).
     pub bin_entries: u64,
-    /// Pixels covered by triangles (coverage before depth test).
+    /// Triangle–tile pairs skipped because the triangle lay behind everything already in the
+    /// tile (LESS / LEQUAL depth test); their pixels are not counted below.
+    pub tiles_depth_rejected: u64,
+    /// Pixels covered by triangles (coverage before depth test), outside rejected tiles.
     pub fragments_covered: u64,
     /// Fragments that reached the fragment shader (after the early depth test).
     pub fragments_shaded: u64,

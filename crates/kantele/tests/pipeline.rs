@@ -422,3 +422,37 @@ fn bad_input_gives_errors_or_defined_results() {
         .sample_grad(&s, Vec2::splat(1e30), Vec2::ZERO, Vec2::ZERO)
         .is_finite());
 }
+
+#[test]
+fn triangles_behind_a_tile_are_skipped_without_changing_the_picture() {
+    // 130 × 70 pixels = 3 × 2 tiles. A near quad, then a far one: with LESS the far quad is
+    // rejected tile by tile; with GREATER it must not be, and it is then drawn.
+    let shader = attribute_shader(Mat4::IDENTITY);
+    let near = quad(-0.5, 0.25);
+    let far = quad(0.5, 0.75);
+    for (func, rejected, expected) in [(DepthFunc::Less, 6, 0.25), (DepthFunc::Greater, 0, 0.75)] {
+        let mut renderer = Renderer::new(130, 70, RendererOptions::default()).expect("renderer");
+        let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
+        frame
+            .draw(&shader, &near, Indices::None, no_cull())
+            .expect("draw");
+        let state = RenderState {
+            depth_func: func,
+            ..no_cull()
+        };
+        frame
+            .draw(&shader, &far, Indices::None, state)
+            .expect("draw");
+        let stats = frame.end();
+        // Two triangles per quad, each touching all 6 tiles.
+        assert_eq!(stats.tiles_depth_rejected, 2 * rejected, "{func:?}");
+        let fb = renderer.framebuffer();
+        for (x, y) in [(0, 0), (129, 69), (64, 35)] {
+            let got = fb.pixel(x, y).expect("pixel").x;
+            assert!(
+                (got - expected).abs() < 1e-5,
+                "{func:?} at ({x}, {y}): {got}"
+            );
+        }
+    }
+}
