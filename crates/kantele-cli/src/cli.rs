@@ -274,6 +274,11 @@ pub struct ViewArgs {
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Quit after N frames (for tests).
+    /// Spin the camera around the scene at this many degrees per second (the blog's spinning
+    /// teapot); dragging still works.
+    #[arg(long, value_name = "DEG_PER_S")]
+    pub spin: Option<f32>,
+
     #[arg(long, hide = true)]
     pub frames: Option<u64>,
     /// Save the last frame as PNG when quitting (for tests).

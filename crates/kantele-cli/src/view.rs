@@ -107,6 +107,8 @@ struct App {
     fps: f64,
     last_frame: Option<FrameImage>,
     error: Option<anyhow::Error>,
+    /// When the spinning camera last moved.
+    last_spin: Option<Instant>,
 }
 
 fn pack(c: [f32; 4]) -> u32 {
@@ -195,6 +197,13 @@ impl App {
         let (Some(nw), Some(nh)) = (NonZeroU32::new(w), NonZeroU32::new(h)) else {
             return Ok(());
         };
+        if let Some(degrees_per_second) = self.args.spin.filter(|d| d.is_finite()) {
+            let now = Instant::now();
+            let dt = self.last_spin.map_or(0.0, |t| (now - t).as_secs_f32());
+            self.last_spin = Some(now);
+            self.orbit.yaw += degrees_per_second.to_radians() * dt;
+            self.orbiting = true;
+        }
         let camera = if self.orbiting {
             self.orbit.camera()
         } else {
@@ -375,6 +384,7 @@ pub fn run(args: ViewArgs) -> Result<()> {
         orbiting: false,
         dragging: false,
         last_cursor: None,
+        last_spin: None,
         gfx: None,
         frames: 0,
         fps_frames: 0,
