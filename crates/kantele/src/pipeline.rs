@@ -246,6 +246,7 @@ pub struct Renderer {
     pool: rayon::ThreadPool,
     strategy: Strategy,
     bins: TileBins,
+    scratch: GeometryScratch,
 }
 
 impl Renderer {
@@ -265,6 +266,7 @@ impl Renderer {
             pool,
             strategy: options.strategy,
             bins: TileBins::default(),
+            scratch: GeometryScratch::default(),
         })
     }
 
@@ -387,13 +389,15 @@ impl<'a> Frame<'_, 'a> {
             pool,
             strategy,
             bins,
+            scratch,
         } = renderer;
         let strategy = *strategy;
         pool.install(|| {
             framebuffer.clear(clear_color, clear_depth);
             let viewport = Viewport::new(framebuffer.width(), framebuffer.height());
             let geometry_start = Instant::now();
-            let geometry = run_geometry(&draws, &viewport, &mut stats);
+            run_geometry(&draws, &viewport, &mut stats, scratch);
+            let geometry = &scratch.output;
             stats.geometry_time = geometry_start.elapsed();
 
             let binning_start = Instant::now();
@@ -485,6 +489,7 @@ impl PrimitiveCounters {
 }
 
 /// The frame's set-up triangles (in draw order) and their varyings.
+#[derive(Default)]
 struct GeometryOutput {
     triangles: Vec<TriangleSetup>,
     /// Varyings of every triangle's three vertices, concatenated in triangle order.
@@ -524,19 +529,55 @@ struct PrimitiveBatch {
     counters: PrimitiveCounters,
 }
 
+impl PrimitiveBatch {
+    fn clear(&mut self) {
+        self.triangles.clear();
+        self.attrs.clear();
+        self.counters = PrimitiveCounters::default();
+    }
+}
+
+/// Where triangles are set up: the viewport and its guard band.
+struct TargetSpace {
+    viewport: Viewport,
+    guard: GuardBand,
+}
+
+/// Buffers of the geometry stages, kept by the renderer between frames so that a frame reuses
+/// the previous one's allocations instead of paging fresh memory in and out.
+#[derive(Default)]
+struct GeometryScratch {
+    /// Vertex-stage output per draw (only the first `draws.len()` are current).
+    shaded: Vec<ShadedVertices>,
+    /// Primitive-stage output per chunk (only the first `jobs` are current).
+    batches: Vec<PrimitiveBatch>,
+    /// The frame's triangles and varyings.
+    output: GeometryOutput,
+}
+
 fn run_geometry(
     draws: &[Box<dyn DrawJob + '_>],
     viewport: &Viewport,
     stats: &mut FrameStats,
-) -> GeometryOutput {
+    scratch: &mut GeometryScratch,
+) {
+    let GeometryScratch {
+        shaded,
+        batches,
+        output,
+    } = scratch;
     // 1. Vertex stage over all draws, in chunks.
-    let mut shaded: Vec<ShadedVertices> = draws
-        .iter()
-        .map(|d| ShadedVertices {
-            pos_clip: vec![Vec4::ZERO; d.vertex_count()],
-            varyings: vec![0.0; d.vertex_count() * d.varying_count()],
-        })
-        .collect();
+    if shaded.len() < draws.len() {
+        shaded.resize_with(draws.len(), ShadedVertices::default);
+    }
+    let shaded = &mut shaded[..draws.len()];
+    for (d, out) in draws.iter().zip(shaded.iter_mut()) {
+        out.pos_clip.clear();
+        out.pos_clip.resize(d.vertex_count(), Vec4::ZERO);
+        out.varyings.clear();
+        out.varyings
+            .resize(d.vertex_count() * d.varying_count(), 0.0);
+    }
     let mut vertex_jobs = Vec::new();
     for (draw, out) in shaded.iter_mut().enumerate() {
         let n = draws[draw].varying_count();
@@ -557,6 +598,7 @@ fn run_geometry(
     vertex_jobs
         .into_par_iter()
         .for_each(|(draw, first, pos, vary)| draws[draw].shade_vertices(first, pos, vary));
+    let shaded = &*shaded;
 
     // 2. Primitive stage over all draws, in chunks; results concatenated in order.
     let mut primitive_jobs = Vec::new();
@@ -574,29 +616,42 @@ fn run_geometry(
             first = last;
         }
     }
-    let guard = GuardBand::new(viewport.width, viewport.height);
-    let batches: Vec<PrimitiveBatch> = primitive_jobs
-        .into_par_iter()
-        .map(|(draw, first, last)| {
+    let target = TargetSpace {
+        viewport: *viewport,
+        guard: GuardBand::new(viewport.width, viewport.height),
+    };
+    if batches.len() < primitive_jobs.len() {
+        batches.resize_with(primitive_jobs.len(), PrimitiveBatch::default);
+    }
+    let batches = &mut batches[..primitive_jobs.len()];
+    batches
+        .par_iter_mut()
+        .zip(primitive_jobs.par_iter())
+        .for_each(|(batch, &(draw, first, last))| {
+            batch.clear();
             draws[draw].assemble(
                 draw as u32,
                 first..last,
                 orders[draw].as_deref(),
                 &shaded[draw],
-                viewport,
-                &guard,
-            )
-        })
-        .collect();
+                &target,
+                batch,
+            );
+        });
 
-    let mut output = GeometryOutput {
-        triangles: Vec::with_capacity(batches.iter().map(|b| b.triangles.len()).sum()),
-        attrs: Vec::with_capacity(batches.iter().map(|b| b.attrs.len()).sum()),
-        draw_first: vec![(0, 0); draws.len()],
-    };
+    output.triangles.clear();
+    output.attrs.clear();
+    output.draw_first.clear();
+    output.draw_first.resize(draws.len(), (0, 0));
+    output
+        .triangles
+        .reserve(batches.iter().map(|b| b.triangles.len()).sum());
+    output
+        .attrs
+        .reserve(batches.iter().map(|b| b.attrs.len()).sum());
     let mut counters = PrimitiveCounters::default();
     let mut next_draw = 0;
-    for batch in batches {
+    for batch in batches.iter() {
         if let Some(first) = batch.triangles.first() {
             // Record where each draw begins (draws with no triangles keep a harmless value).
             while next_draw <= first.draw as usize {
@@ -614,7 +669,6 @@ fn run_geometry(
     stats.triangles_clipped = counters.clipped;
     stats.triangles_culled = counters.culled;
     stats.triangles_degenerate = counters.degenerate;
-    output
 }
 
 /// A queued draw with its shader type erased; the methods run the stages for it, so the hot
@@ -635,9 +689,9 @@ trait DrawJob: Sync {
         triangles: std::ops::Range<usize>,
         order: Option<&[u32]>,
         shaded: &ShadedVertices,
-        viewport: &Viewport,
-        guard: &GuardBand,
-    ) -> PrimitiveBatch;
+        target: &TargetSpace,
+        out: &mut PrimitiveBatch,
+    );
     fn raster(
         &self,
         tri: &TriangleSetup,
@@ -747,11 +801,11 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
         triangles: std::ops::Range<usize>,
         order: Option<&[u32]>,
         shaded: &ShadedVertices,
-        viewport: &Viewport,
-        guard: &GuardBand,
-    ) -> PrimitiveBatch {
+        target: &TargetSpace,
+        out: &mut PrimitiveBatch,
+    ) {
+        let TargetSpace { viewport, guard } = target;
         let n = self.shader.varying_count();
-        let mut out = PrimitiveBatch::default();
         for slot in triangles {
             out.counters.triangles_in += 1;
             let t = order.map_or(slot, |o| o[slot] as usize);
@@ -764,7 +818,7 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
             let vary = ix.map(|i| &shaded.varyings[i * n..(i + 1) * n]);
             match classify(pos, guard) {
                 ClipTest::Reject => out.counters.rejected += 1,
-                ClipTest::Accept => self.emit(draw, t as u32, pos, vary, viewport, &mut out),
+                ClipTest::Accept => self.emit(draw, t as u32, pos, vary, viewport, out),
                 ClipTest::Clip => {
                     out.counters.clipped += 1;
                     let vertex = |k: usize| {
@@ -790,13 +844,12 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
                             [a.pos_clip, b.pos_clip, c.pos_clip],
                             [&a.varyings[..n], &b.varyings[..n], &c.varyings[..n]],
                             viewport,
-                            &mut out,
+                            out,
                         );
                     }
                 }
             }
         }
-        out
     }
 
     fn raster(
