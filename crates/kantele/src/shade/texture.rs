@@ -156,12 +156,13 @@ impl Texture {
     /// level-0 texels (OpenGL 4.6 §8.14, equation 8.6 without the optional approximations).
     pub fn lod(&self, duv_dx: Vec2, duv_dy: Vec2) -> f32 {
         let size = Vec2::new(self.width() as f32, self.height() as f32);
-        let rho_x = (duv_dx * size).length();
-        let rho_y = (duv_dy * size).length();
-        let rho = rho_x.max(rho_y);
-        if rho.is_finite() && rho > 0.0 {
-            rho.log2()
-        } else if rho == 0.0 {
+        // log2 ρ = ½ log2 ρ²: one logarithm, no square roots.
+        let rho2 = (duv_dx * size)
+            .length_squared()
+            .max((duv_dy * size).length_squared());
+        if rho2.is_finite() && rho2 > 0.0 {
+            0.5 * rho2.log2()
+        } else if rho2 == 0.0 {
             f32::NEG_INFINITY
         } else {
             // Non-finite derivatives (degenerate mapping): use the smallest level.
@@ -195,7 +196,7 @@ impl Texture {
                 let level = if lod <= 0.5 {
                     0.0
                 } else {
-                    ((lod + 0.5).ceil() - 1.0).min(max_level)
+                    (-floor(-(lod + 0.5)) - 1.0).min(max_level)
                 };
                 sample_level(&self.levels[level as usize], sampler, filter, uv)
             }
@@ -204,7 +205,7 @@ impl Texture {
                 if lod >= max_level {
                     return sample_level(&self.levels[max_level as usize], sampler, filter, uv);
                 }
-                let lower = lod.floor();
+                let lower = floor(lod);
                 let frac = lod - lower;
                 let a = sample_level(&self.levels[lower as usize], sampler, filter, uv);
                 let b = sample_level(&self.levels[lower as usize + 1], sampler, filter, uv);
@@ -335,8 +336,8 @@ impl Wrap {
     #[inline]
     fn reduce(self, t: f32) -> f32 {
         match self {
-            Wrap::Repeat => t - t.floor(),
-            Wrap::MirroredRepeat => t - 2.0 * (t * 0.5).floor(),
+            Wrap::Repeat => t - floor(t),
+            Wrap::MirroredRepeat => t - 2.0 * floor(t * 0.5),
             Wrap::ClampToEdge => t,
         }
     }
@@ -371,8 +372,8 @@ fn sample_level(level: &MipLevel, sampler: &Sampler, filter: Filter, uv: Vec2) -
         Filter::Linear => {
             let us = u - 0.5;
             let vs = v - 0.5;
-            let i0f = us.floor();
-            let j0f = vs.floor();
+            let i0f = floor(us);
+            let j0f = floor(vs);
             let alpha = us - i0f;
             let beta = vs - j0f;
             let i0 = floor_to_i32(i0f);
@@ -392,13 +393,56 @@ fn sample_level(level: &MipLevel, sampler: &Sampler, filter: Filter, uv: Vec2) -
 /// meaninglessly anyway; this keeps them defined).
 #[inline]
 fn floor_to_i32(x: f32) -> i32 {
-    // `as` saturates for out-of-range floats and maps NaN to 0.
-    x.floor() as i32
+    // `as` truncates towards zero, saturates out of range and maps NaN to 0.
+    let i = x as i32;
+    if (i as f32) > x {
+        i.saturating_sub(1)
+    } else {
+        i
+    }
+}
+
+/// Exact `floor` without a libm call (the x86-64 baseline has no rounding instruction):
+/// values of magnitude 2^23 or more are already integers.
+#[inline]
+fn floor(x: f32) -> f32 {
+    if x.abs() < 8_388_608.0 {
+        floor_to_i32(x) as f32
+    } else {
+        x
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn fast_floor_is_exact() {
+        for x in [
+            0.0f32,
+            -0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            1.5,
+            -1.5,
+            2.999_999_8,
+            -2.999_999_8,
+            8_388_607.5,
+            -8_388_607.5,
+            1e10,
+            -1e10,
+            3e38,
+        ] {
+            assert_eq!(floor(x), x.floor(), "{x}");
+        }
+        assert_eq!(floor_to_i32(-0.25), -1);
+        assert_eq!(floor_to_i32(f32::NAN), 0);
+        assert_eq!(floor_to_i32(1e20), i32::MAX);
+        assert_eq!(floor_to_i32(-1e20), i32::MIN);
+    }
 
     /// A 4 × 1 texture with texel values 0, 1, 2, 3 in red.
     fn ramp() -> Texture {
