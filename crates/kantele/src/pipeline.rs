@@ -874,8 +874,10 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
         let (a0, rest) = attrs.split_at(n);
         let (a1, a2) = rest.split_at(n);
         debug_assert!(rect.width() <= TILE_SIZE as i32);
+        // Counted locally and added once: the closure then keeps them in registers.
+        let (mut covered, mut shaded, mut discarded) = (0u64, 0u64, 0u64);
         rasterize(tri, rect, strategy, |x, y| {
-            counters.covered += 1;
+            covered += 1;
             let bary = tri.barycentrics(x, y);
             let depth = tri.depth_at(&bary);
             // Outside the [0, 1] depth range (or NaN): clipped by the near/far planes.
@@ -908,9 +910,9 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
                 weights,
                 w,
             };
-            counters.shaded += 1;
+            shaded += 1;
             match self.shader.fragment(&fragment) {
-                None => counters.discarded += 1,
+                None => discarded += 1,
                 Some(color) => {
                     tile.color[index] = state.blend.blend(color, tile.color[index]);
                     if state.depth_write {
@@ -919,5 +921,8 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
                 }
             }
         });
+        counters.covered += covered;
+        counters.shaded += shaded;
+        counters.discarded += discarded;
     }
 }
