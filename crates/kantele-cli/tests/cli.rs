@@ -782,3 +782,70 @@ fn every_shared_scene_renders_and_looks_right() {
         );
     }
 }
+
+// ------------------------------------------------------------------- patched reference files
+
+/// Byte range of the first primitive's accessor `attribute` (or its indices when `None`) in a
+/// .glb's binary chunk, with the accessor's component type.
+fn glb_accessor(glb: &[u8], attribute: Option<&str>) -> (usize, usize, u64) {
+    let u32_at =
+        |o: usize| u32::from_le_bytes([glb[o], glb[o + 1], glb[o + 2], glb[o + 3]]) as usize;
+    let json_len = u32_at(12);
+    let json: serde_json::Value =
+        serde_json::from_slice(&glb[20..20 + json_len]).expect("json chunk");
+    let bin_start = 20 + json_len + 8;
+    let primitive = &json["meshes"][0]["primitives"][0];
+    let accessor_index = match attribute {
+        Some(name) => &primitive["attributes"][name],
+        None => &primitive["indices"],
+    }
+    .as_u64()
+    .expect("accessor") as usize;
+    let accessor = &json["accessors"][accessor_index];
+    let view = &json["bufferViews"][accessor["bufferView"].as_u64().expect("view") as usize];
+    let offset = bin_start
+        + view["byteOffset"].as_u64().unwrap_or(0) as usize
+        + accessor["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let component = accessor["componentType"].as_u64().expect("component type");
+    (
+        offset,
+        accessor["count"].as_u64().expect("count") as usize,
+        component,
+    )
+}
+
+/// A reference file with an index past the end of its vertices is refused with a clear message;
+/// one with NaN positions renders (those triangles are dropped) and leaves no error.
+#[test]
+fn patched_reference_files_bad_indices_and_nan_positions() {
+    let Some(scenes) = shared_scenes() else {
+        return;
+    };
+    let original = std::fs::read(scenes.join("blog-teapot.glb")).expect("read");
+    let dir = TempDir::new("patched");
+
+    let mut bad_index = original.clone();
+    let (offset, _, component) = glb_accessor(&bad_index, None);
+    match component {
+        5123 => bad_index[offset..offset + 2].copy_from_slice(&u16::MAX.to_le_bytes()),
+        5125 => bad_index[offset..offset + 4].copy_from_slice(&u32::MAX.to_le_bytes()),
+        other => panic!("unexpected index type {other}"),
+    }
+    std::fs::write(dir.path("bad-index.glb"), &bad_index).expect("write");
+    let o = kantele(&["render", &dir.s("bad-index.glb"), "-o", &dir.s("bad.png")]);
+    assert_clean_failure(&o, "bad-index.glb", &dir, &["bad-index.glb"]);
+    assert!(stderr(&o).contains("index"), "{}", stderr(&o));
+
+    let mut nan = original.clone();
+    let (offset, count, _) = glb_accessor(&nan, Some("POSITION"));
+    // Every third vertex's x becomes NaN: many triangles are dropped, the rest still draw.
+    for v in (0..count).step_by(3) {
+        nan[offset + 12 * v..offset + 12 * v + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    }
+    std::fs::write(dir.path("nan.glb"), &nan).expect("write");
+    let o = kantele(&["render", &dir.s("nan.glb"), "-o", &dir.s("nan.png")]);
+    ok(&o);
+    assert!(!stderr(&o).contains("panicked"));
+    let img = image::open(dir.path("nan.png")).expect("png").to_rgba8();
+    assert_eq!(img.dimensions(), (192, 192));
+}
