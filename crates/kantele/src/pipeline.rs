@@ -420,9 +420,9 @@ impl<'a> Frame<'_, 'a> {
                         let draw = &draws[tri.draw as usize];
                         // Early rejection: behind everything already in this tile.
                         if draw.rejects_by_depth_bound() {
-                            let min_depth = tri.depth[0].min(tri.depth[1]).min(tri.depth[2]);
                             let r = rect.intersect(&tri.bbox);
-                            if tile.occludes(min_depth, r.width() * r.height(), &rect) {
+                            let area = r.width() * r.height();
+                            if tile.occludes(tri.depth_range[0], area, &rect) {
                                 counters.tile_rejected += 1;
                                 continue;
                             }

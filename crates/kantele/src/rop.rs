@@ -96,9 +96,9 @@ pub struct TileBuffer {
     depth_bound_exact: bool,
 }
 
-/// How much a fragment's interpolated depth may fall below its triangle's smallest vertex depth
-/// through `f32` rounding of the barycentric sum (a few ulps of values ≤ 1, with a wide margin).
-const DEPTH_BOUND_SLACK: f32 = 1e-5;
+/// Margin below a triangle's smallest vertex depth. Interpolated depth is clamped to the
+/// vertex range (`TriangleSetup::depth_at`), so none is needed; this is belt and braces.
+const DEPTH_BOUND_SLACK: f32 = 1e-6;
 
 /// Least triangle ∩ tile area (pixels) for which a stale depth bound is recomputed: scanning
 /// 4096 depths pays off only when the triangle could cover many pixels.

@@ -148,6 +148,9 @@ pub struct TriangleSetup {
     pub pos_subpixel: [[i64; 2]; 3],
     /// Window depth `(z/w + 1) / 2` of each vertex.
     pub depth: [f32; 3],
+    /// Smallest and largest vertex depth: interpolated depth is clamped to this range (the
+    /// exact value always lies in it; `f32` barycentrics of slivers can stray a little).
+    pub depth_range: [f32; 2],
     /// `1 / w_clip` of each vertex.
     pub inv_w: [f32; 3],
     /// `1 / area2` as `f32`.
@@ -294,6 +297,10 @@ pub fn setup_triangle(
         area2,
         bbox,
         pos_subpixel: pos,
+        depth_range: [
+            depth[0].min(depth[1]).min(depth[2]),
+            depth[0].max(depth[1]).max(depth[2]),
+        ],
         depth,
         inv_w,
         inv_area2: 1.0 / area2 as f32,
@@ -335,10 +342,12 @@ impl TriangleSetup {
         [1.0 - l1 - l2, l1, l2]
     }
 
-    /// Window depth at the given barycentrics (affine in screen space).
+    /// Window depth at the given barycentrics (affine in screen space), clamped to the
+    /// vertices' depth range.
     #[inline]
     pub fn depth_at(&self, bary: &[f32; 3]) -> f32 {
-        bary[0] * self.depth[0] + bary[1] * self.depth[1] + bary[2] * self.depth[2]
+        let z = bary[0] * self.depth[0] + bary[1] * self.depth[1] + bary[2] * self.depth[2];
+        z.max(self.depth_range[0]).min(self.depth_range[1])
     }
 
     /// Per-pixel derivatives of the screen-space barycentrics: `(dλ/dx, dλ/dy)`.
