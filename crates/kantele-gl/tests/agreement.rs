@@ -9,6 +9,7 @@ use std::sync::Arc;
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::compare::{compare, edge_mask, Comparison};
 use kantele::cpu::{CpuBackend, CpuOptions};
+use kantele::scene::Scene;
 use kantele_gl::GlBackend;
 
 fn scenes_dir() -> Option<PathBuf> {
@@ -21,10 +22,20 @@ fn render(backend: &mut dyn Backend, view: &FrameView) -> FrameImage {
     backend.read_frame().expect("read")
 }
 
+/// The OpenGL backend, or `None` (with a message) where EGL/OpenGL is unavailable.
+fn gl_or_skip() -> Option<GlBackend> {
+    match GlBackend::new() {
+        Ok(gl) => Some(gl),
+        Err(e) => {
+            eprintln!("skipping: OpenGL unavailable: {e}");
+            None
+        }
+    }
+}
+
 /// Renders a scene with both backends; returns (cpu, gl, cpu ids).
-fn render_both(path: &Path, gl: &mut GlBackend) -> (FrameImage, FrameImage, FrameImage) {
-    let loaded = kantele_io::load_scene(path).expect("load");
-    let scene = Arc::new(loaded.scene);
+fn render_both(scene: Scene, gl: &mut GlBackend) -> (FrameImage, FrameImage, FrameImage) {
+    let scene = Arc::new(scene);
     let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu");
     cpu.load(scene.clone()).expect("cpu load");
     gl.load(scene.clone()).expect("gl load");
@@ -43,21 +54,12 @@ fn render_both(path: &Path, gl: &mut GlBackend) -> (FrameImage, FrameImage, Fram
 
 #[test]
 fn builtin_scenes_agree_with_opengl() {
-    let mut gl = match GlBackend::new() {
-        Ok(gl) => gl,
-        Err(e) => {
-            eprintln!("skipping: OpenGL unavailable: {e}");
-            return;
-        }
+    let Some(mut gl) = gl_or_skip() else {
+        return;
     };
     for (name, _) in kantele_io::builtin_scenes() {
-        let scene = Arc::new(kantele_io::builtin_scene(name).expect("builtin").scene);
-        let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu");
-        cpu.load(scene.clone()).expect("cpu load");
-        gl.load(scene.clone()).expect("gl load");
-        let view = FrameView::of_scene(&scene);
-        let a = render(&mut cpu, &view);
-        let b = render(&mut gl, &view);
+        let scene = kantele_io::builtin_scene(name).expect("builtin").scene;
+        let (a, b, _) = render_both(scene, &mut gl);
         let c = compare(&a, &b, None, 0).expect("same size");
         eprintln!(
             "{name:12} coverage {} px, mean {:.3}, max {}",
@@ -81,24 +83,14 @@ fn builtin_scenes_agree_with_opengl() {
 /// backends: the teapot mirrored in x is drawn by both exactly as the unmirrored one's mirror.
 #[test]
 fn mirrored_draws_agree_with_opengl() {
-    let mut gl = match GlBackend::new() {
-        Ok(gl) => gl,
-        Err(e) => {
-            eprintln!("skipping: OpenGL unavailable: {e}");
-            return;
-        }
+    let Some(mut gl) = gl_or_skip() else {
+        return;
     };
     let mut scene = kantele_io::builtin_scene("teapot").expect("builtin").scene;
     for draw in &mut scene.draws {
         draw.model = glam::Mat4::from_scale(glam::Vec3::new(-1.0, 1.0, 1.0)) * draw.model;
     }
-    let scene = Arc::new(scene);
-    let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu");
-    cpu.load(scene.clone()).expect("cpu load");
-    gl.load(scene.clone()).expect("gl load");
-    let view = FrameView::of_scene(&scene);
-    let a = render(&mut cpu, &view);
-    let b = render(&mut gl, &view);
+    let (a, b, _) = render_both(scene, &mut gl);
     let c = compare(&a, &b, None, 0).expect("same size");
     assert!(
         a.depth.iter().filter(|d| **d < 1.0).count() > 10_000,
@@ -121,12 +113,8 @@ fn every_reference_scene_agrees_with_opengl() {
         eprintln!("skipping: ../shared/scenes not found");
         return;
     };
-    let mut gl = match GlBackend::new() {
-        Ok(gl) => gl,
-        Err(e) => {
-            eprintln!("skipping: OpenGL unavailable: {e}");
-            return;
-        }
+    let Some(mut gl) = gl_or_skip() else {
+        return;
     };
     let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
         .expect("read scenes")
@@ -141,7 +129,8 @@ fn every_reference_scene_agrees_with_opengl() {
             .file_stem()
             .map(|s| s.to_string_lossy().into_owned())
             .unwrap_or_default();
-        let (cpu, gl_image, ids) = render_both(path, &mut gl);
+        let scene = kantele_io::load_scene(path).expect("load").scene;
+        let (cpu, gl_image, ids) = render_both(scene, &mut gl);
         let edges = edge_mask(&ids);
         let c: Comparison =
             compare(&cpu, &gl_image, Some(&edges), INTERIOR_BOUND).expect("same size");
