@@ -1,8 +1,8 @@
 //! Scene data in GL objects: one vertex array + vertex buffer + index buffer per mesh, one RGBA32F
 //! texture with its complete mip chain per texture, one sampler object per textured material.
 
-use glam::{Vec2, Vec3, Vec4};
 use glow::HasContext;
+use kantele::material::StandardVertex;
 use kantele::scene::{Material, Mesh, Scene};
 use kantele::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 
@@ -27,44 +27,19 @@ pub(crate) struct GpuScene {
     pub(crate) samplers: Vec<Option<glow::Sampler>>,
 }
 
-/// Interleaved vertices and u32 indices of a mesh, with the defaults of absent attributes:
-/// normal (0, 0, 1), texcoord (0, 0), colour (1, 1, 1, 1).
-///
-/// A mesh without normals is shaded with its flat face normals: every triangle gets its own three
-/// vertices carrying the object-space face normal `normalize((b − a) × (c − a))`, which the normal
-/// matrix then takes to world space like any vertex normal (so it points outwards even under a
-/// mirroring model matrix).
+/// Interleaved vertices (position, normal, texcoord, colour: [`VERTEX_FLOATS`] floats) and u32
+/// indices of a mesh, prepared exactly as the CPU backend prepares it
+/// ([`StandardVertex::from_mesh`]: attribute defaults, flat normals for meshes without any).
 pub(crate) fn interleave(mesh: &Mesh) -> (Vec<f32>, Vec<u32>) {
-    let texcoord = |i: usize| mesh.texcoords.as_ref().map_or(Vec2::ZERO, |t| t[i]);
-    let color = |i: usize| mesh.colors.as_ref().map_or(Vec4::ONE, |c| c[i]);
-    let push = |out: &mut Vec<f32>, i: usize, normal: Vec3| {
-        out.extend_from_slice(&mesh.positions[i].to_array());
-        out.extend_from_slice(&normal.to_array());
-        out.extend_from_slice(&texcoord(i).to_array());
-        out.extend_from_slice(&color(i).to_array());
-    };
-    match &mesh.normals {
-        Some(normals) => {
-            let mut vertices = Vec::with_capacity(mesh.positions.len() * VERTEX_FLOATS);
-            for (i, n) in normals.iter().enumerate() {
-                push(&mut vertices, i, *n);
-            }
-            (vertices, mesh.indices.clone())
-        }
-        None => {
-            let mut vertices = Vec::with_capacity(mesh.indices.len() * VERTEX_FLOATS);
-            for tri in mesh.indices.chunks_exact(3) {
-                let [a, b, c] = [tri[0], tri[1], tri[2]].map(|i| i as usize);
-                let (pa, pb, pc) = (mesh.positions[a], mesh.positions[b], mesh.positions[c]);
-                let normal = (pb - pa).cross(pc - pa).normalize_or_zero();
-                for i in [a, b, c] {
-                    push(&mut vertices, i, normal);
-                }
-            }
-            let indices = (0..(mesh.indices.len() / 3 * 3) as u32).collect();
-            (vertices, indices)
-        }
-    }
+    let (vertices, indices) = StandardVertex::from_mesh(mesh);
+    let floats = vertices
+        .iter()
+        .flat_map(|v| {
+            let (p, n, t, c) = (v.position, v.normal, v.texcoord, v.color);
+            [p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y, c.x, c.y, c.z, c.w]
+        })
+        .collect();
+    (floats, indices)
 }
 
 fn f32_bytes(values: impl IntoIterator<Item = f32>) -> Vec<u8> {
@@ -287,6 +262,7 @@ fn material_binding(material: &Material) -> Option<Sampler> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     #[test]
     fn interleave_fills_defaults() {

@@ -12,7 +12,7 @@ use crate::backend::Pass;
 use crate::camera::normal_matrix;
 use crate::pipeline::{Fragment, RenderState, Shader};
 use crate::rop::BlendMode;
-use crate::scene::{AlphaMode, Material};
+use crate::scene::{AlphaMode, Material, Mesh};
 use crate::setup::CullMode;
 use crate::shade::texture::{Sampler, Texture};
 
@@ -28,6 +28,31 @@ pub struct StandardVertex {
     pub texcoord: Vec2,
     /// Linear RGBA vertex colour (white when the mesh has none).
     pub color: Vec4,
+}
+
+impl StandardVertex {
+    /// The mesh's vertices and triangle list in this layout, with the defaults of absent
+    /// attributes: normal +Z, texcoord (0, 0), colour white. A mesh without normals is
+    /// [flat-shaded](crate::scene::Mesh::flat_shaded) first. Every backend prepares scene meshes
+    /// through this one function, so they see identical vertex data.
+    pub fn from_mesh(mesh: &Mesh) -> (Vec<StandardVertex>, Vec<u32>) {
+        let flat;
+        let mesh = if mesh.normals.is_none() {
+            flat = mesh.flat_shaded();
+            &flat
+        } else {
+            mesh
+        };
+        let vertices = (0..mesh.positions.len())
+            .map(|i| StandardVertex {
+                position: mesh.positions[i],
+                normal: mesh.normals.as_ref().map_or(Vec3::Z, |n| n[i]),
+                texcoord: mesh.texcoords.as_ref().map_or(Vec2::ZERO, |t| t[i]),
+                color: mesh.colors.as_ref().map_or(Vec4::ONE, |c| c[i]),
+            })
+            .collect();
+        (vertices, mesh.indices.clone())
+    }
 }
 
 /// Varyings: world normal (3), texcoord (2), colour (4).

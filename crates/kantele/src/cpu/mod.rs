@@ -22,31 +22,13 @@ struct PreparedMesh {
 
 impl PreparedMesh {
     fn new(mesh: &Mesh) -> Self {
-        let flat;
-        let mesh = if mesh.normals.is_none() {
-            flat = mesh.flat_shaded();
-            &flat
-        } else {
-            mesh
-        };
-        let vertices = (0..mesh.positions.len())
-            .map(|i| StandardVertex {
-                position: mesh.positions[i],
-                normal: mesh.normals.as_ref().map_or(glam::Vec3::Z, |n| n[i]),
-                texcoord: mesh.texcoords.as_ref().map_or(glam::Vec2::ZERO, |t| t[i]),
-                color: mesh.colors.as_ref().map_or(glam::Vec4::ONE, |c| c[i]),
-            })
-            .collect();
-        Self {
-            vertices,
-            indices: mesh.indices.clone(),
-        }
+        let (vertices, indices) = StandardVertex::from_mesh(mesh);
+        Self { vertices, indices }
     }
 }
 
 /// Renders scenes with Kantele's CPU pipeline.
 pub struct CpuBackend {
-    options: CpuOptions,
     renderer: Renderer,
     scene: Option<(Arc<Scene>, Vec<PreparedMesh>)>,
 }
@@ -55,7 +37,6 @@ impl CpuBackend {
     /// A backend with the given options.
     pub fn new(options: CpuOptions) -> Result<Self, RenderError> {
         Ok(Self {
-            options,
             renderer: Renderer::new(1, 1, options)?,
             scene: None,
         })
@@ -68,7 +49,6 @@ impl CpuBackend {
 
     /// Changes the traversal strategy (pictures stay identical).
     pub fn set_strategy(&mut self, strategy: Strategy) {
-        self.options.strategy = strategy;
         self.renderer.set_strategy(strategy);
     }
 
