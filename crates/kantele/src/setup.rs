@@ -153,8 +153,6 @@ pub struct TriangleSetup {
     pub depth_range: [f32; 2],
     /// `1 / w_clip` of each vertex.
     pub inv_w: [f32; 3],
-    /// `1 / area2` as `f32`.
-    pub inv_area2: f32,
     /// `(a_i, b_i) / area2` for edges 1 and 2: `λ_i` at a sample `d` sub-pixel units from
     /// vertex 0 is `g_i · d` (edges 1 and 2 pass through vertex 0, so there is no constant).
     pub bary_gradient: [[f32; 2]; 2],
@@ -303,7 +301,6 @@ pub fn setup_triangle(
         ],
         depth,
         inv_w,
-        inv_area2: 1.0 / area2 as f32,
         bary_gradient: [
             [
                 edges[1].a as f32 / area2 as f32,
@@ -350,22 +347,15 @@ impl TriangleSetup {
         z.max(self.depth_range[0]).min(self.depth_range[1])
     }
 
-    /// Per-pixel derivatives of the screen-space barycentrics: `(dλ/dx, dλ/dy)`.
+    /// Per-pixel derivatives of the screen-space barycentrics: `(dλ/dx, dλ/dy)`, those of the
+    /// values [`TriangleSetup::barycentrics`] computes (`λ0 = 1 − λ1 − λ2`).
     #[inline]
     pub fn barycentric_gradients(&self) -> ([f32; 3], [f32; 3]) {
-        let s = SUBPIXEL_ONE as f32 * self.inv_area2;
-        (
-            [
-                self.edges[0].a as f32 * s,
-                self.edges[1].a as f32 * s,
-                self.edges[2].a as f32 * s,
-            ],
-            [
-                self.edges[0].b as f32 * s,
-                self.edges[1].b as f32 * s,
-                self.edges[2].b as f32 * s,
-            ],
-        )
+        let one = SUBPIXEL_ONE as f32; // one pixel in sub-pixel units
+        let g = &self.bary_gradient;
+        let (dx1, dx2) = (g[0][0] * one, g[1][0] * one);
+        let (dy1, dy2) = (g[0][1] * one, g[1][1] * one);
+        ([-(dx1 + dx2), dx1, dx2], [-(dy1 + dy2), dy1, dy2])
     }
 }
 
