@@ -1,0 +1,23 @@
+"""Kantele: a software rasterizer. Load glTF 2.0 / OBJ files or numpy meshes and render colour,
+depth, normals and ids into numpy arrays on the CPU.
+
+>>> import kantele
+>>> scene = kantele.load("bunny.glb")
+>>> out = scene.render(size=(640, 480))
+>>> out["color"].shape, out["color"].dtype
+((480, 640, 4), dtype('uint8'))
+
+Conventions of every output (row 0 is the top row of the image):
+
+- ``color``: ``uint8`` (H, W, 4), RGB sRGB-encoded, alpha linear (the bytes of the CLI's PNG);
+- ``color_linear``: ``float32`` (H, W, 4), linear RGBA;
+- ``depth``: ``float32`` (H, W), distance along the camera's view axis (OpenCV camera z, scene
+  units), ``inf`` where nothing was drawn;
+- ``normals``: ``float32`` (H, W, 3), world-space unit normals, 0 where nothing was drawn;
+- ``ids``: ``uint32`` (H, W, 3): instance id (glTF node index + 1), primitive id (triangle index
+  in its mesh + 1), draw id (index into ``Scene.draws`` + 1); 0 = background.
+"""
+
+from ._kantele import MAX_SIZE, OUTPUTS, Camera, Scene, load, write_png
+
+__all__ = ["Camera", "Scene", "load", "write_png", "MAX_SIZE", "OUTPUTS"]

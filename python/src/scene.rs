@@ -1,0 +1,394 @@
+//! `kantele.Scene`: a loaded or numpy-built scene, rendered into numpy arrays.
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, PoisonError};
+
+use kantele::backend::{Backend, FrameView};
+use kantele::cpu::{CpuBackend, CpuOptions};
+use kantele::error::RenderError;
+use kantele::scene::Scene;
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+
+use crate::arrays::view_dict;
+use crate::camera::{orbit_cameras, PyCamera, ORBIT_ELEVATION_DEG};
+use crate::errors::{load_error, render_error, value_error};
+use crate::mesh_arrays::{scene_from_arrays, MeshArrays};
+use crate::render::{render_views, OutputKind, RenderedView};
+
+/// A CPU backend with this scene loaded, kept between calls.
+struct CachedCpu {
+    threads: Option<usize>,
+    backend: CpuBackend,
+}
+
+/// A scene ready to render: meshes, materials, textures, camera and light.
+#[pyclass(name = "Scene", module = "kantele", frozen)]
+pub struct PyScene {
+    scene: Arc<Scene>,
+    source: String,
+    warnings: Vec<String>,
+    cpu: Mutex<Option<CachedCpu>>,
+}
+
+impl PyScene {
+    /// Wraps a validated scene.
+    pub fn new(scene: Scene, source: String, warnings: Vec<String>) -> PyResult<Self> {
+        scene
+            .validate()
+            .map_err(|e| value_error(format!("{source}: {e}")))?;
+        Ok(Self {
+            scene: Arc::new(scene),
+            source,
+            warnings,
+            cpu: Mutex::new(None),
+        })
+    }
+
+    /// Loads a scene file (glTF or OBJ) with the GIL released.
+    pub fn load_path(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        let loaded = py
+            .detach(|| kantele_io::load_scene(&path))
+            .map_err(load_error)?;
+        Self::new(loaded.scene, loaded.info.source, loaded.info.warnings)
+    }
+}
+
+/// Which backend renders, parsed from the `backend` argument.
+#[derive(Clone, Copy)]
+enum BackendKind {
+    Cpu,
+    Gl,
+}
+
+fn parse_backend(name: &str) -> PyResult<BackendKind> {
+    match name {
+        "cpu" => Ok(BackendKind::Cpu),
+        "gl" => Ok(BackendKind::Gl),
+        _ => Err(value_error(format!(
+            "unknown backend '{name}' (choose from: cpu, gl)"
+        ))),
+    }
+}
+
+fn parse_outputs(outputs: &Bound<'_, PyAny>) -> PyResult<Vec<OutputKind>> {
+    if outputs.is_instance_of::<pyo3::types::PyString>() {
+        return Err(value_error(
+            "outputs must be a sequence of names, e.g. (\"color\",), not a string",
+        ));
+    }
+    let mut kinds = Vec::new();
+    for item in outputs.try_iter()? {
+        let name: String = item?.extract()?;
+        let kind = OutputKind::parse(&name).map_err(value_error)?;
+        if !kinds.contains(&kind) {
+            kinds.push(kind);
+        }
+    }
+    if kinds.is_empty() {
+        return Err(value_error("outputs is empty: ask for at least one output"));
+    }
+    Ok(kinds)
+}
+
+fn parse_size(size: Option<(i64, i64)>, default: (u32, u32), source: &str) -> PyResult<(u32, u32)> {
+    let max = kantele::MAX_TARGET_SIZE as i64;
+    let (w, h) = match size {
+        Some(s) => s,
+        None => (default.0 as i64, default.1 as i64),
+    };
+    if !(1..=max).contains(&w) || !(1..=max).contains(&h) {
+        let whose = if size.is_some() {
+            "size".to_string()
+        } else {
+            format!("{source}: the scene's resolution")
+        };
+        return Err(value_error(format!(
+            "{whose} {w}x{h} is outside 1..={max} on a side"
+        )));
+    }
+    Ok((w as u32, h as u32))
+}
+
+fn parse_threads(threads: Option<i64>) -> PyResult<Option<usize>> {
+    match threads {
+        None => Ok(None),
+        Some(t) if (1..=1024).contains(&t) => Ok(Some(t as usize)),
+        Some(t) => Err(value_error(format!("threads {t} is outside 1..=1024"))),
+    }
+}
+
+impl PyScene {
+    /// Renders `views` with the GIL released.
+    fn render_frames(
+        &self,
+        py: Python<'_>,
+        views: Vec<FrameView>,
+        outputs: &[OutputKind],
+        backend: BackendKind,
+        threads: Option<usize>,
+    ) -> PyResult<Vec<RenderedView>> {
+        let scene = &self.scene;
+        let cpu = &self.cpu;
+        let result = py.detach(|| -> Result<Vec<RenderedView>, RenderError> {
+            match backend {
+                BackendKind::Cpu => {
+                    // Concurrent renders of one scene take turns on its backend.
+                    let mut cached = cpu.lock().unwrap_or_else(PoisonError::into_inner);
+                    if cached.as_ref().is_none_or(|c| c.threads != threads) {
+                        *cached = None;
+                        let mut backend = CpuBackend::new(CpuOptions {
+                            threads,
+                            ..CpuOptions::default()
+                        })?;
+                        backend.load(scene.clone())?;
+                        *cached = Some(CachedCpu { threads, backend });
+                    }
+                    let cached = cached.as_mut().expect("a backend was made above");
+                    render_views(&mut cached.backend, &views, outputs)
+                }
+                BackendKind::Gl => {
+                    // The GL backend lives and dies on this thread (it is !Send).
+                    let mut gl = kantele_gl::GlBackend::new()?;
+                    gl.load(scene.clone())?;
+                    render_views(&mut gl, &views, outputs)
+                }
+            }
+        });
+        result.map_err(|e| render_error(prefix(&self.source, e)))
+    }
+
+    fn views(
+        &self,
+        cameras: &[Option<PyCamera>],
+        size: Option<(i64, i64)>,
+    ) -> PyResult<Vec<FrameView>> {
+        let (w, h) = parse_size(size, self.scene.resolution, &self.source)?;
+        Ok(cameras
+            .iter()
+            .map(|c| match c {
+                Some(c) => c.frame_view(&self.scene, w, h),
+                None => FrameView::with_camera(&self.scene, &self.scene.camera, w, h),
+            })
+            .collect())
+    }
+}
+
+/// The error with the scene's source in front, as the CLI names the file.
+fn prefix(source: &str, error: RenderError) -> RenderError {
+    match error {
+        RenderError::InvalidScene(m) => RenderError::InvalidScene(format!("{source}: {m}")),
+        other => other,
+    }
+}
+
+#[pymethods]
+impl PyScene {
+    /// Loads a glTF 2.0 (`.gltf`, `.glb`) or OBJ file. Raises `OSError` when the file cannot be
+    /// read and `ValueError` when it is malformed.
+    #[staticmethod]
+    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+        Self::load_path(py, path)
+    }
+
+    /// A scene of one mesh from numpy arrays: `vertices` (N, 3) floats, `faces` (M, 3)
+    /// integers (counter-clockwise = front), optional `normals` (N, 3) (flat shading without),
+    /// `colors` (N, 3 or 4: `uint8` sRGB or float linear), `uvs` (N, 2), (0, 0) = the
+    /// texture's top-left corner, and `texture` (H, W, 3 or 4: `uint8` sRGB or float linear).
+    /// The camera frames the mesh, as for files without one; `resolution` is 800×600.
+    #[staticmethod]
+    #[pyo3(signature = (vertices, faces, normals = None, colors = None, uvs = None, texture = None, double_sided = false))]
+    #[allow(clippy::too_many_arguments)]
+    fn from_arrays<'py>(
+        vertices: Bound<'py, PyAny>,
+        faces: Bound<'py, PyAny>,
+        normals: Option<Bound<'py, PyAny>>,
+        colors: Option<Bound<'py, PyAny>>,
+        uvs: Option<Bound<'py, PyAny>>,
+        texture: Option<Bound<'py, PyAny>>,
+        double_sided: bool,
+    ) -> PyResult<Self> {
+        let arrays = MeshArrays {
+            vertices,
+            faces,
+            normals,
+            colors,
+            uvs,
+            texture,
+        };
+        let scene = scene_from_arrays(&arrays, double_sided)?;
+        Self::new(scene, "arrays".into(), Vec::new())
+    }
+
+    /// A built-in scene by name: `cube`, `teapot`, `ground` or `pixel-edges`.
+    #[staticmethod]
+    fn builtin(name: &str) -> PyResult<Self> {
+        let loaded = kantele_io::builtin_scene(name).map_err(load_error)?;
+        Self::new(loaded.scene, loaded.info.source, loaded.info.warnings)
+    }
+
+    /// Where the scene came from (a path, `builtin:NAME` or `arrays`).
+    #[getter]
+    fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// Problems the loader noticed that did not stop loading.
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
+    }
+
+    /// Triangles drawn per frame.
+    #[getter]
+    fn triangle_count(&self) -> usize {
+        self.scene.triangle_count()
+    }
+
+    /// The image size `(width, height)` the scene asks for (used when `size` is `None`).
+    #[getter]
+    fn resolution(&self) -> (u32, u32) {
+        self.scene.resolution
+    }
+
+    /// The scene's own camera: the file's, or one framing everything drawn.
+    #[getter]
+    fn camera(&self) -> PyCamera {
+        PyCamera {
+            camera: self.scene.camera,
+        }
+    }
+
+    /// `views` cameras circling the scene, each framing all of it for images of `size` (default:
+    /// the scene's resolution), `elevation` degrees above its equator: the cameras of
+    /// `kantele render --orbit VIEWS`.
+    #[pyo3(signature = (views, size = None, elevation = ORBIT_ELEVATION_DEG))]
+    fn orbit_cameras(
+        &self,
+        views: usize,
+        size: Option<(i64, i64)>,
+        elevation: f32,
+    ) -> PyResult<Vec<PyCamera>> {
+        let (w, h) = parse_size(size, self.scene.resolution, &self.source)?;
+        let cameras = orbit_cameras(&self.scene, views, w as f32 / h as f32, elevation)
+            .map_err(|e| value_error(format!("{}: {e}", self.source)))?;
+        Ok(cameras
+            .into_iter()
+            .map(|camera| PyCamera { camera })
+            .collect())
+    }
+
+    /// World-space bounding sphere `((x, y, z), radius)` of everything drawn, or `None`.
+    #[getter]
+    fn bounding_sphere(&self) -> Option<((f32, f32, f32), f32)> {
+        self.scene
+            .bounding_sphere()
+            .map(|(c, r)| ((c.x, c.y, c.z), r))
+    }
+
+    /// One dict per draw, indexed by draw id − 1: `id`, `node_index`, `node_name`,
+    /// `mesh_index`, `mesh_name` (the meaning of the `ids` output's channels).
+    #[getter]
+    fn draws<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let list = PyList::empty(py);
+        for (i, d) in self.scene.draws.iter().enumerate() {
+            let dict = PyDict::new(py);
+            dict.set_item("id", i + 1)?;
+            dict.set_item("node_index", d.node_index)?;
+            dict.set_item("node_name", &d.node_name)?;
+            dict.set_item("mesh_index", d.mesh)?;
+            let mesh_name = self
+                .scene
+                .meshes
+                .get(d.mesh)
+                .map_or("", |m| m.name.as_str());
+            dict.set_item("mesh_name", mesh_name)?;
+            list.append(dict)?;
+        }
+        Ok(list)
+    }
+
+    /// Renders one view and returns a dict of numpy arrays, one per name in `outputs`:
+    ///
+    /// - `color`: `uint8` (H, W, 4), sRGB-encoded RGB and alpha, row 0 at the top (the CLI's PNG);
+    /// - `color_linear`: `float32` (H, W, 4) linear RGBA;
+    /// - `depth`: `float32` (H, W), distance along the camera's view axis (OpenCV z), `inf` where
+    ///   nothing was drawn;
+    /// - `normals`: `float32` (H, W, 3) world-space unit normals, 0 where nothing was drawn;
+    /// - `ids`: `uint32` (H, W, 3): instance (node index + 1), primitive (triangle + 1) and draw
+    ///   (draw index + 1) ids, 0 = background.
+    ///
+    /// `camera=None` uses the scene's camera, `size=None` the scene's resolution. The GIL is
+    /// released while rendering.
+    #[pyo3(signature = (camera = None, size = None, outputs = None, backend = "cpu", threads = None))]
+    fn render<'py>(
+        &self,
+        py: Python<'py>,
+        camera: Option<PyCamera>,
+        size: Option<(i64, i64)>,
+        outputs: Option<Bound<'py, PyAny>>,
+        backend: &str,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let mut all = self.render_many_impl(py, vec![camera], size, outputs, backend, threads)?;
+        view_dict(py, all.remove(0))
+    }
+
+    /// Renders every camera of `cameras` (a `None` entry is the scene's camera) and returns a
+    /// list of dicts as [`render`] does. The scene is prepared once; the GIL is released for
+    /// the whole batch.
+    #[pyo3(signature = (cameras, size = None, outputs = None, backend = "cpu", threads = None))]
+    fn render_many<'py>(
+        &self,
+        py: Python<'py>,
+        cameras: Vec<Option<PyCamera>>,
+        size: Option<(i64, i64)>,
+        outputs: Option<Bound<'py, PyAny>>,
+        backend: &str,
+        threads: Option<i64>,
+    ) -> PyResult<Bound<'py, PyList>> {
+        let all = self.render_many_impl(py, cameras, size, outputs, backend, threads)?;
+        let list = PyList::empty(py);
+        for view in all {
+            list.append(view_dict(py, view)?)?;
+        }
+        Ok(list)
+    }
+
+    fn __repr__(&self) -> String {
+        format!(
+            "Scene(source={:?}, triangles={}, draws={}, resolution={}x{})",
+            self.source,
+            self.scene.triangle_count(),
+            self.scene.draws.len(),
+            self.scene.resolution.0,
+            self.scene.resolution.1
+        )
+    }
+}
+
+impl PyScene {
+    fn render_many_impl<'py>(
+        &self,
+        py: Python<'py>,
+        cameras: Vec<Option<PyCamera>>,
+        size: Option<(i64, i64)>,
+        outputs: Option<Bound<'py, PyAny>>,
+        backend: &str,
+        threads: Option<i64>,
+    ) -> PyResult<Vec<RenderedView>> {
+        let outputs = match outputs {
+            Some(o) => parse_outputs(&o)?,
+            None => vec![
+                OutputKind::Color,
+                OutputKind::Depth,
+                OutputKind::Normals,
+                OutputKind::Ids,
+            ],
+        };
+        let backend = parse_backend(backend)?;
+        let threads = parse_threads(threads)?;
+        let views = self.views(&cameras, size)?;
+        self.render_frames(py, views, &outputs, backend, threads)
+    }
+}

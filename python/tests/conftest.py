@@ -1,0 +1,47 @@
+"""Shared helpers of the Python tests: where the repository, the reference scenes and the
+`kantele` command are, and the `KANTELE_REQUIRE` rule (a named dependency that is missing fails
+instead of skipping)."""
+
+import os
+import shutil
+import subprocess
+from pathlib import Path
+
+import pytest
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def required(name: str) -> bool:
+    """Whether `KANTELE_REQUIRE` (comma- or space-separated) names `name`."""
+    return name in os.environ.get("KANTELE_REQUIRE", "").replace(",", " ").split()
+
+
+def skip_or_fail(name: str, reason: str):
+    """Skips the test with `reason`, or fails it when `KANTELE_REQUIRE` names `name`."""
+    if required(name):
+        pytest.fail(f"{reason} (KANTELE_REQUIRE names '{name}')")
+    pytest.skip(reason)
+
+
+@pytest.fixture(scope="session")
+def scenes_dir() -> Path:
+    """`../shared/scenes` beside the repository (or `KANTELE_SCENES`)."""
+    d = Path(os.environ.get("KANTELE_SCENES", REPO.parent / "shared" / "scenes"))
+    if not d.is_dir():
+        skip_or_fail("scenes", f"{d} is absent")
+    return d
+
+
+@pytest.fixture(scope="session")
+def cli() -> str:
+    """The `kantele` binary cargo built (release or debug), building it when there is none."""
+    target = Path(os.environ.get("CARGO_TARGET_DIR", REPO / "target"))
+    for profile in ("release", "debug"):
+        exe = target / profile / "kantele"
+        if exe.is_file():
+            return str(exe)
+    if shutil.which("cargo") is None:
+        skip_or_fail("cli", "no kantele binary in target/ and no cargo to build one")
+    subprocess.run(["cargo", "build", "-p", "kantele-cli"], cwd=REPO, check=True)
+    return str(target / "debug" / "kantele")

@@ -1,0 +1,81 @@
+"""The Python package against the `kantele` command, same scenes and views: colour byte for
+byte, depth (eye distance, PFM) and ids (16-bit PNG) exactly, normals within the PNG's
+8-bit quantisation."""
+
+import subprocess
+
+import numpy as np
+import pytest
+
+import kantele
+from pngread import read_pfm, read_png
+
+# Scenes whose ids fit the CLI's 16-bit PNG (bunny's 69451 triangles do not).
+SCENES = ["thesis-cube-textured.glb", "spot-textured.glb", "alpha-blend.glb", "thesis-t2-cubes.glb"]
+SIZE = (96, 72)
+
+
+def cli_render(cli, scene_paths, out_dir, orbit=None):
+    args = [cli, "render", *map(str, scene_paths), "--size", f"{SIZE[0]}x{SIZE[1]}",
+            "-o", f"{out_dir}/{{stem}}_{{frame}}.png",
+            "--depth", f"{out_dir}/{{stem}}_{{frame}}.pfm",
+            "--normals", f"{out_dir}/{{stem}}_{{frame}}_n.png",
+            "--ids", f"{out_dir}/{{stem}}_{{frame}}_ids.png"]
+    if orbit:
+        args += ["--orbit", str(orbit)]
+    subprocess.run(args, check=True, capture_output=True)
+
+
+def cli_base(out_dir, stem, frame):
+    """The CLI's file name stem for a view: `{frame}` is zero-padded to a width of its own."""
+    for f in out_dir.glob(f"{stem}_*.png.json"):
+        number = f.name[len(stem) + 1 : -len(".png.json")]
+        if number.isdigit() and int(number) == frame:
+            return out_dir / f"{stem}_{number}"
+    raise AssertionError(f"the CLI wrote no {stem} view {frame} in {out_dir}")
+
+
+def check_same(expected_dir, stem, frame, out):
+    base = cli_base(expected_dir, stem, frame)
+    np.testing.assert_array_equal(out["color"], read_png(f"{base}.png"),
+                                  err_msg=f"{stem} view {frame}: colour differs from the CLI")
+    np.testing.assert_array_equal(out["depth"], read_pfm(f"{base}.pfm"))
+    ids = read_png(f"{base}_ids.png")
+    assert ids.dtype == np.uint16
+    np.testing.assert_array_equal(out["ids"], ids.astype(np.uint32))
+    normals_png = read_png(f"{base}_n.png")
+    covered = normals_png[..., 3] == 255
+    assert covered.any()
+    encoded = np.round(np.clip(out["normals"] * 0.5 + 0.5, 0, 1) * 255).astype(np.uint8)
+    np.testing.assert_array_equal(encoded[covered], normals_png[..., :3][covered])
+    assert (out["normals"][~covered] == 0).all()
+    assert np.isinf(out["depth"][~covered]).all()
+    assert np.isfinite(out["depth"][covered]).all()
+
+
+def test_scene_cameras_match_the_cli(cli, scenes_dir, tmp_path):
+    paths = [scenes_dir / s for s in SCENES]
+    cli_render(cli, paths, tmp_path)
+    for p in paths:
+        out = kantele.load(p).render(size=SIZE)
+        check_same(tmp_path, p.stem, 0, out)
+
+
+def test_orbit_views_match_the_cli(cli, scenes_dir, tmp_path):
+    path = scenes_dir / "spot-textured.glb"
+    cli_render(cli, [path], tmp_path, orbit=3)
+    scene = kantele.load(path)
+    views = scene.render_many(scene.orbit_cameras(3, size=SIZE), size=SIZE)
+    assert len(views) == 3
+    for frame, out in enumerate(views):
+        check_same(tmp_path, "spot-textured", frame, out)
+    # The views differ from each other.
+    assert not np.array_equal(views[0]["color"], views[1]["color"])
+
+
+def test_builtin_scene_matches_the_cli(cli, tmp_path):
+    subprocess.run([cli, "render", "--builtin", "teapot", "--size", f"{SIZE[0]}x{SIZE[1]}",
+                    "-o", f"{tmp_path}/teapot_0.png", "--depth", f"{tmp_path}/teapot_0.pfm",
+                    "--normals", f"{tmp_path}/teapot_0_n.png",
+                    "--ids", f"{tmp_path}/teapot_0_ids.png"], check=True, capture_output=True)
+    check_same(tmp_path, "teapot", 0, kantele.Scene.builtin("teapot").render(size=SIZE))
