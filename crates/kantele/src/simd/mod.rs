@@ -77,6 +77,8 @@ use std::sync::OnceLock;
 mod avx2;
 mod rounding;
 mod scalar;
+#[cfg(target_arch = "x86_64")]
+mod sse2;
 #[cfg(test)]
 mod tests;
 
@@ -84,6 +86,8 @@ mod tests;
 pub use avx2::{Avx2, Avx2F32, Avx2I32, Avx2Mask};
 pub use rounding::{floor, round_ties_even};
 pub use scalar::{Scalar, ScalarF32, ScalarI32, ScalarMask};
+#[cfg(target_arch = "x86_64")]
+pub use sse2::{Sse2, Sse41, SseF32, SseI32, SseLevel, SseMask};
 
 /// The environment variable that forces an instruction set (see [`Isa::from_env`]).
 pub const ISA_ENV: &str = "KANTELE_ISA";
@@ -123,9 +127,9 @@ impl Isa {
     pub fn is_supported(self) -> bool {
         match self {
             Isa::Scalar => true,
-            #[cfg(all(target_arch = "x86_64", any()))]
+            #[cfg(target_arch = "x86_64")]
             Isa::Sse2 => Sse2::new().is_some(),
-            #[cfg(all(target_arch = "x86_64", any()))]
+            #[cfg(target_arch = "x86_64")]
             Isa::Sse41 => Sse41::new().is_some(),
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => Avx2::new().is_some(),
@@ -235,13 +239,13 @@ pub fn dispatch<K: LaneKernel>(isa: Isa, kernel: K) -> K::Output {
                 return avx2::run(token, kernel);
             }
         }
-        #[cfg(all(target_arch = "x86_64", any()))]
+        #[cfg(target_arch = "x86_64")]
         Isa::Sse41 => {
             if let Some(token) = Sse41::new() {
                 return sse2::run_sse41(token, kernel);
             }
         }
-        #[cfg(all(target_arch = "x86_64", any()))]
+        #[cfg(target_arch = "x86_64")]
         Isa::Sse2 => {
             if let Some(token) = Sse2::new() {
                 return kernel.run(token);

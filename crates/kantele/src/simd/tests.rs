@@ -477,6 +477,14 @@ fn avx2_dispatch_runs_avx2_code_where_the_cpu_has_it() {
     }
     assert_eq!(Isa::Avx2.is_supported(), has_avx2);
     assert!(!Isa::Neon.is_supported());
+    assert!(
+        Isa::Sse2.is_supported(),
+        "SSE2 is part of the x86-64 baseline"
+    );
+    assert_eq!(
+        Isa::Sse41.is_supported(),
+        std::arch::is_x86_feature_detected!("sse4.1")
+    );
     let expected = if has_avx2 { Isa::Avx2 } else { Isa::Scalar };
     assert_eq!(dispatch(Isa::Avx2, WhichIsa), expected);
     if has_avx2 {
