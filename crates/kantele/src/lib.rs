@@ -121,11 +121,9 @@ pub mod setup;
 pub mod shade;
 #[allow(unsafe_code)]
 pub mod simd;
+pub mod state;
 pub mod stats;
 
 pub use error::RenderError;
 
-/// Largest render target side in pixels.
-pub const MAX_TARGET_SIZE: u32 = 16384;
-/// Most `f32` varyings a vertex can carry to the fragment stage.
-pub const MAX_VARYINGS: usize = 16;
+pub use state::{MAX_TARGET_SIZE, MAX_VARYINGS};
