@@ -41,6 +41,7 @@ mod builtin;
 mod gltf_loader;
 pub mod mesh_util;
 mod obj_loader;
+pub mod output;
 pub mod pose;
 mod texture_util;
 
