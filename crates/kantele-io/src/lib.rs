@@ -41,6 +41,8 @@ mod builtin;
 mod gltf_loader;
 pub mod mesh_util;
 mod obj_loader;
+pub mod output;
+pub mod pose;
 mod texture_util;
 
 pub use mesh_util::flat_normals;

@@ -60,12 +60,25 @@ impl FrameView {
         height: u32,
     ) -> Self {
         let aspect = width as f32 / height.max(1) as f32;
-        let (to_light, light_color) = scene.light.resolve(&camera.view);
+        Self::with_matrices(scene, camera.view, camera.projection(aspect), width, height)
+    }
+
+    /// The scene seen through explicit `view` (world → eye, OpenGL) and `projection` matrices
+    /// at `width × height`, lit by the scene's light (a headlight follows `view`). This is the
+    /// constructor camera modules such as `kantele_io::pose` build frames with.
+    pub fn with_matrices(
+        scene: &Scene,
+        view: Mat4,
+        projection: Mat4,
+        width: u32,
+        height: u32,
+    ) -> Self {
+        let (to_light, light_color) = scene.light.resolve(&view);
         Self {
             width,
             height,
-            view: camera.view,
-            projection: camera.projection(aspect),
+            view,
+            projection,
             to_light,
             light_color,
             pass: Pass::Color,

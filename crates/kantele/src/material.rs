@@ -10,11 +10,12 @@ use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 use crate::backend::Pass;
 use crate::camera::normal_matrix;
-use crate::pipeline::{Fragment, RenderState, Shader};
+use crate::pipeline::{Fragment, FragmentLanes, RenderState, ShadedLanes, Shader};
 use crate::rop::BlendMode;
 use crate::scene::{AlphaMode, Material, Mesh};
 use crate::setup::CullMode;
 use crate::shade::texture::{Sampler, Texture};
+use crate::simd::{F32x8, Lanes, Mask8};
 
 /// The vertex layout of scene meshes.
 #[repr(C)]
@@ -199,6 +200,11 @@ impl Shader for MaterialShader<'_> {
         let light = Vec3::splat(l.ambient) + (1.0 - l.ambient) * n_dot_l * l.light_color;
         Some((base.truncate() * light).extend(alpha))
     }
+
+    #[inline(always)]
+    fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+        self.shade_lanes(fragments)
+    }
 }
 
 impl MaterialShader<'_> {
@@ -213,6 +219,138 @@ impl MaterialShader<'_> {
                 self.ids.1,
                 1.0,
             ),
+        }
+    }
+}
+
+/// The lane-wide fragment program: the same operations as [`Shader::fragment`] above, in the same
+/// order, on eight pixels at once.
+impl MaterialShader<'_> {
+    #[inline(always)]
+    fn shade_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+        let lanes = f.lanes;
+        let all = lanes.mask_all(true);
+        let needs_alpha = !matches!(self.material.alpha_mode, AlphaMode::Opaque);
+        if self.pass != Pass::Color && !needs_alpha {
+            return ShadedLanes {
+                color: self.auxiliary_lanes(f),
+                keep: all,
+            };
+        }
+        let base = self.base_color_lanes(f);
+        let (alpha, keep) = match self.material.alpha_mode {
+            AlphaMode::Opaque => (lanes.splat_f32(1.0), all),
+            AlphaMode::Mask { cutoff } => (
+                lanes.splat_f32(1.0),
+                base[3].simd_lt(lanes.splat_f32(cutoff)).not(),
+            ),
+            AlphaMode::Blend => (base[3], all),
+        };
+        if self.pass != Pass::Color {
+            return ShadedLanes {
+                color: self.auxiliary_lanes(f),
+                keep,
+            };
+        }
+        if self.material.unlit {
+            return ShadedLanes {
+                color: [base[0], base[1], base[2], alpha],
+                keep,
+            };
+        }
+        let l = self.lighting;
+        let n = self.normal_lanes(f);
+        let n_dot_l = (n[0] * lanes.splat_f32(l.to_light.x)
+            + n[1] * lanes.splat_f32(l.to_light.y)
+            + n[2] * lanes.splat_f32(l.to_light.z))
+        .max(lanes.splat_f32(0.0));
+        let diffuse = lanes.splat_f32(1.0 - l.ambient) * n_dot_l;
+        let ambient = lanes.splat_f32(l.ambient);
+        let light = l
+            .light_color
+            .to_array()
+            .map(|c| ambient + diffuse * lanes.splat_f32(c));
+        ShadedLanes {
+            color: [
+                base[0] * light[0],
+                base[1] * light[1],
+                base[2] * light[2],
+                alpha,
+            ],
+            keep,
+        }
+    }
+
+    /// `baseColorFactor × COLOR_0 × texture(uv)` per lane; the texture is sampled lane by lane.
+    #[inline(always)]
+    fn base_color_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 4] {
+        let lanes = f.lanes;
+        let factor = self.material.base_color_factor.to_array();
+        let mut base = [0, 1, 2, 3].map(|c| lanes.splat_f32(factor[c]) * f.varying(5 + c));
+        if let Some((texture, sampler)) = self.texture {
+            let (u, v) = (f.varying(3).to_array(), f.varying(4).to_array());
+            let (du_dx, du_dy) = f.derivatives(3);
+            let (dv_dx, dv_dy) = f.derivatives(4);
+            let (du_dx, du_dy) = (du_dx.to_array(), du_dy.to_array());
+            let (dv_dx, dv_dy) = (dv_dx.to_array(), dv_dy.to_array());
+            let active = f.active.bits();
+            let mut texel = [[0.0f32; 8]; 4];
+            for k in 0..8 {
+                if active & (1 << k) == 0 {
+                    continue;
+                }
+                let t = texture.sample_grad(
+                    &sampler,
+                    Vec2::new(u[k], v[k]),
+                    Vec2::new(du_dx[k], dv_dx[k]),
+                    Vec2::new(du_dy[k], dv_dy[k]),
+                );
+                for (channel, value) in texel.iter_mut().zip(t.to_array()) {
+                    channel[k] = value;
+                }
+            }
+            for c in 0..4 {
+                base[c] = base[c] * lanes.f32_from_array(texel[c]);
+            }
+        }
+        base
+    }
+
+    /// The interpolated world normal, renormalised (zero when degenerate, as
+    /// `Vec3::normalize_or_zero`), flipped on back faces of double-sided materials.
+    #[inline(always)]
+    fn normal_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 3] {
+        let lanes = f.lanes;
+        let n = [f.varying(0), f.varying(1), f.varying(2)];
+        let length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+        let rcp = lanes.splat_f32(1.0) / length2.sqrt();
+        let usable = rcp
+            .abs()
+            .simd_lt(lanes.splat_f32(f32::INFINITY))
+            .and(rcp.simd_gt(lanes.splat_f32(0.0)));
+        let zero = lanes.splat_f32(0.0);
+        let mut n = n.map(|c| usable.select_f32(c * rcp, zero));
+        if self.material.double_sided && !f.front_facing {
+            n = n.map(|c| -c);
+        }
+        n
+    }
+
+    /// The value of the normals or ids pass, per lane.
+    #[inline(always)]
+    fn auxiliary_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 4] {
+        let lanes = f.lanes;
+        match self.pass {
+            Pass::Normals => {
+                let n = self.normal_lanes(f);
+                [n[0], n[1], n[2], lanes.splat_f32(1.0)]
+            }
+            _ => [
+                lanes.splat_f32(self.ids.0),
+                lanes.splat_f32(f.primitive_id as f32 + 1.0),
+                lanes.splat_f32(self.ids.1),
+                lanes.splat_f32(1.0),
+            ],
         }
     }
 }
