@@ -1,5 +1,4 @@
-//! Writing images to files from Python (`kantele.write_png`).
-// TODO(output): use kantele_io::output once the shared writers are on main.
+//! Writing images from Python with the CLI's writers (`kantele_io::output`).
 
 use std::path::PathBuf;
 
@@ -9,24 +8,25 @@ use pyo3::prelude::*;
 
 use crate::errors::value_error;
 
-/// Writes an 8-bit RGBA or RGB image (`uint8` (H, W, 4) or (H, W, 3), row 0 at the top) as PNG.
+/// Writes an 8-bit RGBA image (`uint8` (H, W, 4), row 0 at the top, e.g. the `color` output)
+/// as PNG, atomically, with the encoder `kantele render` uses.
 #[pyfunction]
 pub fn write_png(py: Python<'_>, path: PathBuf, image: PyReadonlyArray3<'_, u8>) -> PyResult<()> {
     let shape = image.shape().to_vec();
-    let color = match shape[2] {
-        4 => image::ExtendedColorType::Rgba8,
-        3 => image::ExtendedColorType::Rgb8,
-        c => {
-            return Err(value_error(format!(
-                "{}: expected an (H, W, 3 or 4) uint8 image, got {c} channels",
-                path.display()
-            )))
-        }
-    };
+    if shape[2] != 4 {
+        return Err(value_error(format!(
+            "{}: expected an (H, W, 4) uint8 image, got {} channels",
+            path.display(),
+            shape[2]
+        )));
+    }
     let (Ok(w), Ok(h)) = (u32::try_from(shape[1]), u32::try_from(shape[0])) else {
         return Err(value_error(format!("{}: image too large", path.display())));
     };
-    let data = image.as_array().iter().copied().collect::<Vec<u8>>();
-    py.detach(|| image::save_buffer_with_format(&path, &data, w, h, color, image::ImageFormat::Png))
-        .map_err(|e| PyOSError::new_err(format!("{}: {e}", path.display())))
+    let data: Vec<u8> = match image.as_slice() {
+        Ok(slice) => slice.to_vec(),
+        Err(_) => image.as_array().iter().copied().collect(),
+    };
+    py.detach(|| kantele_io::output::write_png_rgba8(&path, w, h, &data))
+        .map_err(|e| PyOSError::new_err(e.to_string()))
 }

@@ -4,7 +4,6 @@
 
 mod arrays;
 mod camera;
-mod depth;
 mod errors;
 mod files;
 mod mesh_arrays;

@@ -3,8 +3,8 @@
 
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::error::RenderError;
-
-use crate::depth::eye_depth;
+use kantele::scene::Scene;
+use kantele_io::pose::CameraPose;
 
 /// One array `Scene.render` can return.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -15,6 +15,8 @@ pub enum OutputKind {
     ColorLinear,
     /// `float32` H×W: distance along the camera's view axis (OpenCV `z`), background `inf`.
     Depth,
+    /// `float32` H×W: distance from the camera centre to the surface, background `inf`.
+    RayDepth,
     /// `float32` H×W×3 world-space unit normals, background 0.
     Normals,
     /// `uint32` H×W×3: instance (node index + 1), primitive (triangle index + 1), draw
@@ -24,10 +26,11 @@ pub enum OutputKind {
 
 impl OutputKind {
     /// Every output with its Python name.
-    pub const ALL: [(&'static str, OutputKind); 5] = [
+    pub const ALL: [(&'static str, OutputKind); 6] = [
         ("color", OutputKind::Color),
         ("color_linear", OutputKind::ColorLinear),
         ("depth", OutputKind::Depth),
+        ("ray_depth", OutputKind::RayDepth),
         ("normals", OutputKind::Normals),
         ("ids", OutputKind::Ids),
     ];
@@ -59,7 +62,10 @@ impl OutputKind {
     /// The pass that produces it.
     fn pass(self) -> Pass {
         match self {
-            OutputKind::Color | OutputKind::ColorLinear | OutputKind::Depth => Pass::Color,
+            OutputKind::Color
+            | OutputKind::ColorLinear
+            | OutputKind::Depth
+            | OutputKind::RayDepth => Pass::Color,
             OutputKind::Normals => Pass::Normals,
             OutputKind::Ids => Pass::Ids,
         }
@@ -80,21 +86,22 @@ pub enum Pixels {
 /// The outputs of one view, in the order they were asked for.
 pub type RenderedView = Vec<(OutputKind, Pixels)>;
 
-/// Renders every view with `backend` (which has the scene loaded) and extracts `outputs`.
+/// Renders `scene` (loaded into `backend`) through every camera and extracts `outputs`.
 /// Each pass is rendered once per view, only when an output needs it.
 pub fn render_views(
     backend: &mut dyn Backend,
-    views: &[FrameView],
+    scene: &Scene,
+    cameras: &[CameraPose],
     outputs: &[OutputKind],
 ) -> Result<Vec<RenderedView>, RenderError> {
-    let mut result = Vec::with_capacity(views.len());
-    for view in views {
+    let mut result = Vec::with_capacity(cameras.len());
+    for camera in cameras {
         let mut frames: Vec<(Pass, FrameImage)> = Vec::new();
         let mut rendered = Vec::with_capacity(outputs.len());
         for &kind in outputs {
             let pass = kind.pass();
             if !frames.iter().any(|(p, _)| *p == pass) {
-                let frame = render_pass(backend, &FrameView { pass, ..*view })?;
+                let frame = render_pass(backend, &camera.frame_view(scene, pass))?;
                 frames.push((pass, frame));
             }
             let frame = frames
@@ -102,7 +109,7 @@ pub fn render_views(
                 .find(|(p, _)| *p == pass)
                 .map(|(_, f)| f)
                 .expect("the pass was rendered above");
-            rendered.push((kind, extract(kind, frame, view)?));
+            rendered.push((kind, extract(kind, frame, camera)?));
         }
         result.push(rendered);
     }
@@ -128,21 +135,19 @@ fn render_pass(backend: &mut dyn Backend, view: &FrameView) -> Result<FrameImage
     Ok(frame)
 }
 
-fn extract(kind: OutputKind, frame: &FrameImage, view: &FrameView) -> Result<Pixels, RenderError> {
+fn extract(
+    kind: OutputKind,
+    frame: &FrameImage,
+    camera: &CameraPose,
+) -> Result<Pixels, RenderError> {
     let (h, w) = (frame.height as usize, frame.width as usize);
     Ok(match kind {
         OutputKind::Color => Pixels::U8(frame.to_rgba8(true), [h, w, 4]),
         OutputKind::ColorLinear => {
             Pixels::F32(frame.color.iter().flatten().copied().collect(), [h, w, 4])
         }
-        OutputKind::Depth => Pixels::F32(
-            frame
-                .depth
-                .iter()
-                .map(|&d| eye_depth(d, &view.projection))
-                .collect(),
-            [h, w, 1],
-        ),
+        OutputKind::Depth => Pixels::F32(camera.planar_depth(&frame.depth), [h, w, 1]),
+        OutputKind::RayDepth => Pixels::F32(camera.ray_depth(&frame.depth), [h, w, 1]),
         OutputKind::Normals => Pixels::F32(
             frame
                 .color

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::sync::{Arc, Mutex, PoisonError};
 
-use kantele::backend::{Backend, FrameView};
+use kantele::backend::Backend;
 use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::error::RenderError;
 use kantele::scene::Scene;
@@ -11,10 +11,11 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::arrays::view_dict;
-use crate::camera::{orbit_cameras, PyCamera, ORBIT_ELEVATION_DEG};
+use crate::camera::{self, pose_error, PyCamera, ORBIT_ELEVATION_DEG, ORBIT_YFOV_DEG};
 use crate::errors::{load_error, render_error, value_error};
 use crate::mesh_arrays::{scene_from_arrays, MeshArrays};
 use crate::render::{render_views, OutputKind, RenderedView};
+use kantele_io::pose::CameraPose;
 
 /// A CPU backend with this scene loaded, kept between calls.
 struct CachedCpu {
@@ -119,11 +120,11 @@ fn parse_threads(threads: Option<i64>) -> PyResult<Option<usize>> {
 }
 
 impl PyScene {
-    /// Renders `views` with the GIL released.
+    /// Renders the scene through `views` with the GIL released.
     fn render_frames(
         &self,
         py: Python<'_>,
-        views: Vec<FrameView>,
+        views: Vec<CameraPose>,
         outputs: &[OutputKind],
         backend: BackendKind,
         threads: Option<usize>,
@@ -145,32 +146,52 @@ impl PyScene {
                         *cached = Some(CachedCpu { threads, backend });
                     }
                     let cached = cached.as_mut().expect("a backend was made above");
-                    render_views(&mut cached.backend, &views, outputs)
+                    render_views(&mut cached.backend, scene, &views, outputs)
                 }
                 BackendKind::Gl => {
                     // The GL backend lives and dies on this thread (it is !Send).
                     let mut gl = kantele_gl::GlBackend::new()?;
                     gl.load(scene.clone())?;
-                    render_views(&mut gl, &views, outputs)
+                    render_views(&mut gl, scene, &views, outputs)
                 }
             }
         });
         result.map_err(|e| render_error(prefix(&self.source, e)))
     }
 
+    /// The scene's own camera, not tied to a size.
+    fn scene_camera(&self) -> PyResult<PyCamera> {
+        let (w, h) = parse_size(None, self.scene.resolution, &self.source)?;
+        let pose = CameraPose::from_scene_camera(&self.scene.camera, w, h)
+            .map_err(|e| value_error(format!("{}: camera: {e}", self.source)))?;
+        Ok(PyCamera::new(pose, false))
+    }
+
+    /// The pose of each camera (`None`: the scene's) at its image size: `size`, else the
+    /// camera's own size, else the scene's resolution.
     fn views(
         &self,
         cameras: &[Option<PyCamera>],
         size: Option<(i64, i64)>,
-    ) -> PyResult<Vec<FrameView>> {
-        let (w, h) = parse_size(size, self.scene.resolution, &self.source)?;
-        Ok(cameras
-            .iter()
-            .map(|c| match c {
-                Some(c) => c.frame_view(&self.scene, w, h),
-                None => FrameView::with_camera(&self.scene, &self.scene.camera, w, h),
-            })
-            .collect())
+    ) -> PyResult<Vec<CameraPose>> {
+        let explicit = match size {
+            Some(_) => Some(parse_size(size, (0, 0), &self.source)?),
+            None => None,
+        };
+        let mut poses = Vec::with_capacity(cameras.len());
+        let mut scene_camera = None;
+        for c in cameras {
+            let camera = match c {
+                Some(c) => c,
+                None => scene_camera.get_or_insert(self.scene_camera()?),
+            };
+            let (w, h) = match (explicit, camera.size()) {
+                (Some(s), _) | (None, Some(s)) => s,
+                (None, None) => parse_size(None, self.scene.resolution, &self.source)?,
+            };
+            poses.push(camera.pose_at(w, h).map_err(pose_error)?);
+        }
+        Ok(poses)
     }
 }
 
@@ -251,31 +272,43 @@ impl PyScene {
         self.scene.resolution
     }
 
-    /// The scene's own camera: the file's, or one framing everything drawn.
+    /// The scene's own camera: the file's, or one framing everything drawn (not tied to an
+    /// image size: it renders at the `size` asked for, else the scene's resolution).
     #[getter]
-    fn camera(&self) -> PyCamera {
-        PyCamera {
-            camera: self.scene.camera,
-        }
+    fn camera(&self) -> PyResult<PyCamera> {
+        self.scene_camera()
     }
 
-    /// `views` cameras circling the scene, each framing all of it for images of `size` (default:
-    /// the scene's resolution), `elevation` degrees above its equator: the cameras of
-    /// `kantele render --orbit VIEWS`.
-    #[pyo3(signature = (views, size = None, elevation = ORBIT_ELEVATION_DEG))]
+    /// `views` cameras circling the scene at `elevation` degrees above its centre, each
+    /// framing all of it for images of `size` (default: the scene's resolution) with a vertical
+    /// field of view of `yfov_deg`: the cameras of `kantele render --orbit VIEWS`.
+    #[pyo3(signature = (views, size = None, elevation = ORBIT_ELEVATION_DEG, yfov_deg = ORBIT_YFOV_DEG))]
     fn orbit_cameras(
         &self,
-        views: usize,
+        views: u32,
         size: Option<(i64, i64)>,
         elevation: f32,
+        yfov_deg: f32,
     ) -> PyResult<Vec<PyCamera>> {
         let (w, h) = parse_size(size, self.scene.resolution, &self.source)?;
-        let cameras = orbit_cameras(&self.scene, views, w as f32 / h as f32, elevation)
-            .map_err(|e| value_error(format!("{}: {e}", self.source)))?;
-        Ok(cameras
-            .into_iter()
-            .map(|camera| PyCamera { camera })
-            .collect())
+        let poses = camera::orbit(&self.scene, views, w, h, elevation, yfov_deg)
+            .map_err(|e| value_error(format!("{}: {}", self.source, e.0)))?;
+        Ok(poses.into_iter().map(|p| PyCamera::new(p, true)).collect())
+    }
+
+    /// A camera framing everything the scene draws, seen from `direction` (a vector from the
+    /// scene towards the camera), for images of `size` (default: the scene's resolution).
+    #[pyo3(signature = (direction = [0.4, 0.5, 1.0], size = None, yfov_deg = ORBIT_YFOV_DEG))]
+    fn framing_camera(
+        &self,
+        direction: [f32; 3],
+        size: Option<(i64, i64)>,
+        yfov_deg: f32,
+    ) -> PyResult<PyCamera> {
+        let (w, h) = parse_size(size, self.scene.resolution, &self.source)?;
+        let pose = camera::framing(&self.scene, direction.into(), w, h, yfov_deg)
+            .map_err(|e| value_error(format!("{}: {}", self.source, e.0)))?;
+        Ok(PyCamera::new(pose, true))
     }
 
     /// World-space bounding sphere `((x, y, z), radius)` of everything drawn, or `None`.

@@ -80,19 +80,37 @@ def test_bad_render_arguments_are_value_errors():
 
 
 def test_bad_cameras_are_value_errors():
-    with pytest.raises(ValueError, match="collinear"):
+    with pytest.raises(ValueError, match="same point"):
         kantele.Camera.look_at((0, 0, 1), (0, 0, 1))
-    with pytest.raises(ValueError, match="collinear"):
-        kantele.Camera.look_at((0, 5, 0), (0, 0, 0), (0, 1, 0))
-    with pytest.raises(ValueError, match="yfov"):
+    with pytest.raises(ValueError, match=r"yfov 4 rad is outside \(0, π\)"):
         kantele.Camera.look_at((0, 0, 1), (0, 0, 0), yfov=4.0)
-    with pytest.raises(ValueError, match="not finite"):
+    with pytest.raises(ValueError, match="must be finite"):
         kantele.Camera.look_at((0, 0, float("inf")), (0, 0, 0))
-    with pytest.raises(ValueError, match="views 0"):
+    with pytest.raises(ValueError, match="znear"):
+        kantele.Camera.look_at((0, 0, 1), (0, 0, 0), znear=-1.0)
+    with pytest.raises(ValueError, match="focal lengths must be finite and > 0"):
+        kantele.Camera.from_opencv(-1, 100, 10, 10, np.eye(4), size=(20, 20))
+    with pytest.raises(ValueError, match=r"expected a \(4, 4\) or \(3, 4\) matrix"):
+        kantele.Camera.from_opencv(100, 100, 10, 10, np.eye(3), size=(20, 20))
+    with pytest.raises(ValueError, match="singular"):
+        kantele.Camera.from_opencv(100, 100, 10, 10, np.zeros((4, 4)), size=(20, 20))
+    with pytest.raises(ValueError, match="outside 1..=16384"):
+        kantele.Camera.from_opencv(100, 100, 10, 10, np.eye(4), size=(0, 20))
+    with pytest.raises(ValueError, match="orbit of 0 views"):
         kantele.Scene.builtin("cube").orbit_cameras(0)
     empty = kantele.Scene.from_arrays(np.zeros((0, 3)), np.zeros((0, 3), np.int64))
     with pytest.raises(ValueError, match="draws nothing"):
         empty.orbit_cameras(3)
+    with pytest.raises(ValueError, match="no image size of its own"):
+        kantele.Camera.look_at((0, 0, 1), (0, 0, 0)).intrinsics()
+
+
+def test_a_pinhole_camera_renders_only_at_its_own_size():
+    cam = kantele.Camera.from_opencv(50, 50, 15.5, 11.5, np.eye(4), size=(32, 24))
+    scene = kantele.Scene.from_arrays(V + [0, 0, 5], F, double_sided=True)
+    assert scene.render(camera=cam, outputs=("ids",))["ids"].shape == (24, 32, 3)
+    with pytest.raises(ValueError, match="intrinsics are for 32x24 images, not 64x48"):
+        scene.render(camera=cam, size=(64, 48))
 
 
 def test_write_png_errors(tmp_path):
