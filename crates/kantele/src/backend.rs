@@ -117,6 +117,11 @@ pub trait Backend {
     fn renderer(&self) -> String;
     /// Threads the backend renders with (1 for a GPU driver).
     fn threads(&self) -> usize;
+    /// The instruction set of the backend's per-pixel path (`"avx2"`, `"scalar"`, …), or `"-"`
+    /// where the question does not apply (a GPU driver).
+    fn isa(&self) -> String {
+        "-".to_string()
+    }
     /// Takes the scene and uploads what it needs. Not part of a frame.
     fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError>;
     /// Renders one complete frame of the loaded scene and waits until it is finished.

@@ -19,30 +19,10 @@ pub fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// Whether `KANTELE_REQUIRE` (a comma-separated list) names `what`: then a test that would skip
-/// for want of it fails instead (CI sets it for what CI is meant to have).
-pub fn required(what: &str) -> bool {
-    std::env::var("KANTELE_REQUIRE")
-        .unwrap_or_default()
-        .split(',')
-        .any(|w| w.trim() == what)
-}
-
 /// The reference scenes, when this checkout has them next to it (a failure instead of a skip
 /// when `KANTELE_REQUIRE` names `scenes`).
 pub fn reference_scenes() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
-    if dir.is_dir() {
-        Some(dir)
-    } else if required("scenes") {
-        panic!(
-            "KANTELE_REQUIRE names scenes, but {} does not exist",
-            dir.display()
-        );
-    } else {
-        eprintln!("reference scenes not found at {}; skipping", dir.display());
-        None
-    }
+    kantele_testkit::shared_dir("scenes")
 }
 
 /// A PNG of the given RGBA texels.

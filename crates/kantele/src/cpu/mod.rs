@@ -71,6 +71,10 @@ impl Backend for CpuBackend {
         self.renderer.threads()
     }
 
+    fn isa(&self) -> String {
+        self.renderer.isa().name().to_string()
+    }
+
     fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError> {
         scene.validate()?;
         let meshes = scene.meshes.iter().map(PreparedMesh::new).collect();

@@ -52,13 +52,12 @@ pub(super) fn raster_tiles(
     framebuffer
         .tiles_mut()
         .par_iter_mut()
-        .zip(bins.bins.par_iter())
         .enumerate()
-        .map(|(tile_index, (tile, bin))| {
+        .map(|(tile_index, tile)| {
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();
             let mut coverage = BlockCoverage::default();
-            for &t in bin {
+            for t in bins.tile(tile_index) {
                 let tri = &geometry.triangles[t as usize];
                 let draw = &draws[tri.draw as usize];
                 // Early rejection: behind everything already in this tile.
