@@ -13,6 +13,8 @@ Conventions of every output (row 0 is the top row of the image):
 - ``color_linear``: ``float32`` (H, W, 4), linear RGBA;
 - ``depth``: ``float32`` (H, W), distance along the camera's view axis (OpenCV camera z, scene
   units), ``inf`` where nothing was drawn;
+- ``ray_depth``: ``float32`` (H, W), distance from the camera centre, ``inf`` where nothing was
+  drawn;
 - ``normals``: ``float32`` (H, W, 3), world-space unit normals, 0 where nothing was drawn;
 - ``ids``: ``uint32`` (H, W, 3): instance id (glTF node index + 1), primitive id (triangle index
   in its mesh + 1), draw id (index into ``Scene.draws`` + 1); 0 = background.

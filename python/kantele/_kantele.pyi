@@ -1,13 +1,13 @@
 """Type stubs of the extension module (re-exported by `kantele`)."""
 
 import os
-from typing import Dict, List, Literal, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Literal, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
 
 PathLike = Union[str, "os.PathLike[str]"]
-OutputName = Literal["color", "color_linear", "depth", "normals", "ids"]
+OutputName = Literal["color", "color_linear", "depth", "ray_depth", "normals", "ids"]
 Backend = Literal["cpu", "gl"]
 
 MAX_SIZE: int
@@ -23,7 +23,10 @@ def write_png(path: PathLike, image: npt.NDArray[np.uint8]) -> None:
     """Writes a `uint8` (H, W, 4) or (H, W, 3) image, row 0 at the top, as PNG."""
 
 class Camera:
-    """A perspective camera (OpenGL conventions: looks down -Z of its frame, y up)."""
+    """A camera (conventions of `kantele_io::pose`, as the CLI's sidecar): the OpenGL camera
+    frame looks down -Z with y up, the OpenCV frame down +Z with y down; intrinsics in pixels
+    with the top-left pixel's centre at (0, 0); matrices row-major, points as columns. A camera
+    may be tied to an image size (pinhole cameras always are)."""
 
     @staticmethod
     def look_at(
@@ -31,19 +34,65 @@ class Camera:
         target: Sequence[float],
         up: Sequence[float] = (0.0, 1.0, 0.0),
         yfov: float = 0.8,
+        size: Optional[Tuple[int, int]] = None,
+        znear: Optional[float] = None,
+        zfar: Optional[float] = None,
+    ) -> Camera:
+        """Perspective camera at `eye` looking at `target`; `yfov` in radians; depth range
+        [0.01*|eye-target|, inf) unless given."""
+    @staticmethod
+    def from_opencv(
+        fx: float,
+        fy: float,
+        cx: float,
+        cy: float,
+        world_to_camera: npt.ArrayLike,
+        size: Tuple[int, int],
         znear: float = 0.01,
         zfar: Optional[float] = None,
     ) -> Camera:
-        """A camera at `eye` looking at `target`; `yfov` in radians; `zfar=None`: infinite."""
+        """Pinhole camera from OpenCV intrinsics and a (4, 4) or (3, 4) OpenCV world-to-camera
+        matrix, for images of `size` = (width, height)."""
+    @staticmethod
+    def from_opengl(
+        world_to_camera: npt.ArrayLike,
+        yfov: float = 0.8,
+        size: Optional[Tuple[int, int]] = None,
+        znear: float = 0.01,
+        zfar: Optional[float] = None,
+    ) -> Camera:
+        """Perspective camera from an OpenGL world-to-camera (view) matrix."""
+    @staticmethod
+    def read_views(path: PathLike, size: Optional[Tuple[int, int]] = None) -> List[Camera]:
+        """Cameras of a view file: `kantele render` sidecars, `to_dict()` output, or pose
+        records (see `kantele render --views`)."""
+    def with_depth_range(self, znear: float, zfar: Optional[float] = None) -> Camera: ...
+    @property
+    def size(self) -> Optional[Tuple[int, int]]:
+        """The image size the camera was made for, or None."""
     @property
     def world_to_camera_gl(self) -> npt.NDArray[np.float32]:
-        """4x4 world -> camera matrix, OpenGL camera frame (x right, y up, looking down -z)."""
+        """4x4 world -> camera, OpenGL frame (x right, y up, looking down -z)."""
     @property
-    def yfov(self) -> float: ...
+    def world_to_camera_opencv(self) -> npt.NDArray[np.float32]:
+        """4x4 world -> camera, OpenCV frame (x right, y down, looking down +z)."""
+    @property
+    def eye(self) -> Tuple[float, float, float]: ...
+    @property
+    def yfov(self) -> Optional[float]: ...
     @property
     def znear(self) -> float: ...
     @property
     def zfar(self) -> Optional[float]: ...
+    def intrinsics(
+        self, size: Optional[Tuple[int, int]] = None
+    ) -> Tuple[float, float, float, float]:
+        """(fx, fy, cx, cy) in pixels for images of `size` (default: the camera's size)."""
+    def projection(self, size: Optional[Tuple[int, int]] = None) -> npt.NDArray[np.float32]:
+        """4x4 OpenGL projection (eye -> clip) for images of `size`."""
+    def to_dict(self, size: Optional[Tuple[int, int]] = None) -> Dict[str, Any]:
+        """{"camera": {...}, "world_to_camera_gl": rows, "world_to_camera_opencv": rows}, the
+        layout of a `kantele render` sidecar."""
 
 class Scene:
     """A scene ready to render."""
@@ -85,9 +134,20 @@ class Scene:
     def draws(self) -> List[Dict[str, Union[int, str]]]:
         """Per draw: id, node_index, node_name, mesh_index, mesh_name."""
     def orbit_cameras(
-        self, views: int, size: Optional[Tuple[int, int]] = None, elevation: float = 20.0
+        self,
+        views: int,
+        size: Optional[Tuple[int, int]] = None,
+        elevation: float = 20.0,
+        yfov_deg: float = 45.0,
     ) -> List[Camera]:
         """The cameras of `kantele render --orbit VIEWS` for images of `size`."""
+    def framing_camera(
+        self,
+        direction: Sequence[float] = (0.4, 0.5, 1.0),
+        size: Optional[Tuple[int, int]] = None,
+        yfov_deg: float = 45.0,
+    ) -> Camera:
+        """A camera framing everything drawn, seen from `direction`."""
     def render(
         self,
         camera: Optional[Camera] = None,
@@ -98,7 +158,8 @@ class Scene:
     ) -> Dict[str, np.ndarray]:
         """Renders one view (GIL released). Outputs (default color, depth, normals, ids):
         color uint8 (H, W, 4) sRGB; color_linear float32 (H, W, 4); depth float32 (H, W)
-        distance along the view axis, inf = background; normals float32 (H, W, 3) world space,
+        distance along the view axis, inf = background; ray_depth float32 (H, W) distance from
+        the camera centre; normals float32 (H, W, 3) world space,
         0 = background; ids uint32 (H, W, 3) instance, primitive, draw; 0 = background."""
     def render_many(
         self,

@@ -55,6 +55,10 @@ def test_command_line_on_two_workers_equals_single_process_renders(tmp_path):
         np.testing.assert_array_equal(read_png(out / files["color"]), expected["color"])
         np.testing.assert_array_equal(np.load(out / files["depth"]), expected["depth"])
         np.testing.assert_array_equal(np.load(out / files["ids"]), expected["ids"])
+        # The manifest holds each view's camera as a sidecar does.
+        np.testing.assert_array_equal(r["world_to_camera_opencv"], cam.world_to_camera_opencv)
+        assert (r["camera"]["fx"], r["camera"]["cy"]) == pytest.approx(
+            (cam.intrinsics()[0], cam.intrinsics()[3]))
     # Rendered in Ray worker processes, not in the driver (which of the two actors takes a
     # batch is Ray's choice).
     assert all(r["worker_pid"] != os.getpid() for r in renders)
@@ -71,6 +75,17 @@ def test_command_line_errors_are_one_line(tmp_path):
         [sys.executable, "-m", "kantele.ray", str(tmp_path), "--size", "12", "--out",
          str(tmp_path / "o")], capture_output=True, text=True, timeout=60)
     assert run.returncode == 2 and "WxH" in run.stderr
+    # A scene that only fails inside a Ray worker still ends in one line naming it.
+    bad = tmp_path / "broken.obj"
+    bad.write_text("v 0 0 0\nf 1 2 3\n")
+    run = subprocess.run(
+        [sys.executable, "-m", "kantele.ray", str(bad), "--size", "8x8", "--workers", "1",
+         "--out", str(tmp_path / "o")], capture_output=True, text=True, timeout=300)
+    assert run.returncode == 1, run.stderr[-2000:]
+    last = run.stderr.strip().splitlines()[-1]
+    assert last.startswith("kantele.ray: ") and "broken.obj" in last, run.stderr[-2000:]
+    manifest = json.loads((tmp_path / "o" / "manifest.json").read_text())
+    assert manifest["renders"] == [] and "broken.obj" in manifest["errors"][0]
 
 
 def write_obj(path, vertices, faces):

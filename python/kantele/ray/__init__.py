@@ -12,7 +12,7 @@ columns for ``write_parquet``::
     ds = ds.map_batches(kr.Renderer, fn_constructor_kwargs={"size": (256, 256),
                         "outputs": ("color", "depth", "ids")},
                         batch_size=4, concurrency=2, num_cpus=1)
-    ds.write_parquet("renders/")                 # columns: scene, stem, view, color, depth, ids
+    ds.write_parquet("renders/")     # columns: scene, stem, view, camera, color, depth, ids
 
 With ``out_dir=...`` the actors write ``{stem}_{view:03d}.png`` (colour) and
 ``{stem}_{view:03d}_{output}.npy`` (depth, normals, ids, color_linear) and return one row of
@@ -26,6 +26,7 @@ Views are ``Scene.orbit_cameras(views, size)``: the cameras of ``kantele render 
 from __future__ import annotations
 
 import json
+import logging
 import os
 import time
 from pathlib import Path
@@ -115,24 +116,30 @@ class Renderer:
             self.scenes[path] = kantele.load(path)
         return self.scenes[path]
 
-    def render_rows(self, batch: Dict[str, np.ndarray]) -> List[Tuple[str, int, Dict[str, np.ndarray]]]:
-        """Renders every row of ``batch``: ``(scene path, view, arrays)`` in row order."""
-        results = []
-        order: Dict[Tuple[str, int], List[int]] = {}
+    def render_rows(self, batch: Dict[str, np.ndarray]) -> List[Tuple[str, int, Any, Any]]:
+        """Renders every row of ``batch`` (rows of one scene together, with ``render_many``):
+        ``(scene path, view, camera, arrays)`` in row order. With ``out_dir``, a scene that
+        cannot be loaded or rendered gives ``(path, view, None, message)`` rows instead of
+        failing the whole job."""
+        groups: Dict[Tuple[str, int], List[int]] = {}
         for i, (path, views) in enumerate(zip(batch["scene"], batch["views"])):
-            order.setdefault((str(path), int(views)), []).append(i)
+            groups.setdefault((str(path), int(views)), []).append(i)
         out: List[Any] = [None] * len(batch["scene"])
-        for (path, views), indices in order.items():
-            scene = self.scene(path)
-            cameras = scene.orbit_cameras(views, size=self.size)
-            chosen = [cameras[int(batch["view"][i])] for i in indices]
-            images = scene.render_many(
-                chosen, size=self.size, outputs=self.outputs, threads=self.threads
-            )
-            for i, arrays in zip(indices, images):
-                out[i] = (path, int(batch["view"][i]), arrays)
-        results.extend(out)
-        return results
+        for (path, views), indices in groups.items():
+            try:
+                scene = self.scene(path)
+                cameras = scene.orbit_cameras(views, size=self.size)
+                chosen = [cameras[int(batch["view"][i])] for i in indices]
+                images = scene.render_many(chosen, outputs=self.outputs, threads=self.threads)
+            except (OSError, ValueError) as e:
+                if self.out_dir is None:
+                    raise
+                for i in indices:
+                    out[i] = (path, int(batch["view"][i]), None, str(e))
+                continue
+            for i, camera, arrays in zip(indices, chosen, images):
+                out[i] = (path, int(batch["view"][i]), camera, arrays)
+        return out
 
     def __call__(self, batch: Dict[str, np.ndarray]) -> Dict[str, Any]:
         rendered = self.render_rows(batch)
@@ -140,13 +147,19 @@ class Renderer:
             "scene": [r[0] for r in rendered],
             "stem": [Path(r[0]).stem for r in rendered],
             "view": [r[1] for r in rendered],
+            # The camera as a `kantele render` sidecar has it (Camera.read_views reads it).
+            "camera": [json.dumps(r[2].to_dict() if r[2] else None) for r in rendered],
         }
         if self.out_dir is None:
             for o in self.outputs:
-                columns[o] = np.stack([r[2][o] for r in rendered])
+                columns[o] = np.stack([r[3][o] for r in rendered])
             return columns
-        files = []
-        for path, view, arrays in rendered:
+        files, errors = [], []
+        for path, view, camera, arrays in rendered:
+            if camera is None:
+                files.append(json.dumps({}))
+                errors.append(arrays)
+                continue
             names = file_names(Path(path).stem, view, self.outputs)
             for o, name in names.items():
                 target = os.path.join(self.out_dir, name)
@@ -155,7 +168,9 @@ class Renderer:
                 else:
                     np.save(target, arrays[o])
             files.append(json.dumps(names))
+            errors.append("")
         columns["files"] = files
+        columns["error"] = errors
         columns["worker_pid"] = [os.getpid()] * len(rendered)
         return columns
 
@@ -170,7 +185,8 @@ def render_files(
     batch_size: int = 4,
 ) -> Dict[str, Any]:
     """Renders ``views`` orbit views of every scene on ``workers`` Ray actors (one CPU each) into
-    ``out_dir`` and writes ``out_dir/manifest.json``; returns the manifest. Uses the running Ray
+    ``out_dir`` and writes ``out_dir/manifest.json``; returns the manifest. Scenes that cannot
+    be loaded or rendered are left out and listed (one message each) under ``errors``. Uses the running Ray
     (``ray.init(address=...)`` first for a cluster) or starts a local one with ``workers``
     CPUs."""
     import ray
@@ -183,7 +199,8 @@ def render_files(
     os.makedirs(out_dir, exist_ok=True)
     out_abs = os.path.abspath(out_dir)
     if not ray.is_initialized():
-        ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False)
+        ray.init(num_cpus=workers, include_dashboard=False, log_to_driver=False,
+                 logging_level=logging.getLogger("ray").getEffectiveLevel())
     start = time.perf_counter()
     ds = dataset(scenes, views).map_batches(
         Renderer,
@@ -195,6 +212,8 @@ def render_files(
     )
     records = sorted(ds.take_all(), key=lambda r: (str(r["scene"]), int(r["view"])))
     elapsed = time.perf_counter() - start
+    failed = [r for r in records if r["error"]]
+    records = [r for r in records if not r["error"]]
     manifest = {
         "size": [int(size[0]), int(size[1])],
         "views": views,
@@ -210,9 +229,11 @@ def render_files(
                 "view": int(r["view"]),
                 "files": json.loads(r["files"]),
                 "worker_pid": int(r["worker_pid"]),
+                **json.loads(r["camera"]),
             }
             for r in records
         ],
+        "errors": sorted({str(r["error"]) for r in failed}),
     }
     with open(os.path.join(out_dir, "manifest.json"), "w") as f:
         json.dump(manifest, f, indent=2)

@@ -5,6 +5,7 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import sys
 from typing import List, Optional, Tuple
 
@@ -40,20 +41,34 @@ def main(argv: Optional[List[str]] = None) -> int:
 
     try:
         import ray
+        import ray.data
     except ImportError:
         print('kantele.ray: Ray is not installed (pip install "kantele[ray]")', file=sys.stderr)
         return 2
     from . import find_scenes, render_files
 
+    # Ray's own progress and info lines would drown the one-line result or error.
+    logging.getLogger("ray").setLevel(logging.ERROR)
+    ray.data.DataContext.get_current().enable_progress_bars = False
+
     try:
         scenes = find_scenes(args.scenes)
         outputs = [o.strip() for o in args.outputs.split(",") if o.strip()]
         if args.address:
-            ray.init(address=args.address, log_to_driver=False)
+            ray.init(address=args.address, log_to_driver=False, logging_level=logging.ERROR)
         manifest = render_files(scenes, args.views, args.size, args.out, args.workers,
                                 outputs, args.batch_size)
     except (OSError, ValueError) as e:
         print(f"kantele.ray: {e}", file=sys.stderr)
+        return 1
+    except ray.exceptions.RayError as e:
+        # A scene that fails inside a worker: its one-line message is the error's last line.
+        lines = [line for line in str(e).splitlines() if line.strip()]
+        print(f"kantele.ray: {lines[-1] if lines else e}", file=sys.stderr)
+        return 1
+    for error in manifest["errors"]:
+        print(f"kantele.ray: {error}", file=sys.stderr)
+    if manifest["errors"]:
         return 1
     n = len(manifest["renders"])
     print(f"{n} views of {len(scenes)} scenes in {manifest['elapsed_s']:.2f} s "
