@@ -99,7 +99,7 @@ pub use sse2::{Sse2, Sse41, SseF32, SseI32, SseLevel, SseMask};
 pub const ISA_ENV: &str = "KANTELE_ISA";
 
 /// Instruction-set levels, from the portable reference to the widest.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Isa {
     /// Plain Rust over arrays: the readable reference, available everywhere.
     Scalar,
