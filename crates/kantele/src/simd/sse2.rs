@@ -204,6 +204,31 @@ fn blend_i<T: SseLevel>(mask: __m128, t: __m128i, f: __m128i) -> __m128i {
     )))
 }
 
+// SSE4.1 operations are `#[inline(always)]` functions rather than closures: a closure is a
+// function of its own, compiled without SSE4.1, and if LLVM kept it out of line the intrinsic
+// inside would become a call.
+
+/// `pmulld`; only called where `T::SSE41` holds.
+#[inline(always)]
+fn mullo_sse41<T: SseLevel>(a: __m128i, b: __m128i) -> __m128i {
+    debug_assert!(T::SSE41);
+    sse41!(_mm_mullo_epi32(a, b))
+}
+
+/// `pminsd`; only called where `T::SSE41` holds.
+#[inline(always)]
+fn min_epi32_sse41<T: SseLevel>(a: __m128i, b: __m128i) -> __m128i {
+    debug_assert!(T::SSE41);
+    sse41!(_mm_min_epi32(a, b))
+}
+
+/// `pmaxsd`; only called where `T::SSE41` holds.
+#[inline(always)]
+fn max_epi32_sse41<T: SseLevel>(a: __m128i, b: __m128i) -> __m128i {
+    debug_assert!(T::SSE41);
+    sse41!(_mm_max_epi32(a, b))
+}
+
 /// Rounds to the nearest integer, ties to even (`roundps` semantics for every non-NaN input).
 #[inline(always)]
 fn round_ties_even4<T: SseLevel>(x: __m128) -> __m128 {
@@ -394,7 +419,7 @@ impl<T: SseLevel> Mul for SseI32<T> {
     #[inline(always)]
     fn mul(self, other: SseI32<T>) -> SseI32<T> {
         if T::SSE41 {
-            return self.zip(other, |a, b| sse41!(_mm_mullo_epi32(a, b)));
+            return self.zip(other, mullo_sse41::<T>);
         }
         // The low 32 bits of the unsigned products are those of the signed ones.
         self.zip(other, |a, b| {
@@ -569,14 +594,14 @@ impl<T: SseLevel> I32x8 for SseI32<T> {
     #[inline(always)]
     fn min(self, other: Self) -> Self {
         if T::SSE41 {
-            return self.zip(other, |a, b| sse41!(_mm_min_epi32(a, b)));
+            return self.zip(other, min_epi32_sse41::<T>);
         }
         self.simd_gt(other).select_i32(other, self)
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
         if T::SSE41 {
-            return self.zip(other, |a, b| sse41!(_mm_max_epi32(a, b)));
+            return self.zip(other, max_epi32_sse41::<T>);
         }
         self.simd_gt(other).select_i32(self, other)
     }
