@@ -266,10 +266,11 @@ impl MaterialShader<'_> {
         .max(lanes.splat_f32(0.0));
         let diffuse = lanes.splat_f32(1.0 - l.ambient) * n_dot_l;
         let ambient = lanes.splat_f32(l.ambient);
-        let light = l
-            .light_color
-            .to_array()
-            .map(|c| ambient + diffuse * lanes.splat_f32(c));
+        let light = [
+            ambient + diffuse * lanes.splat_f32(l.light_color.x),
+            ambient + diffuse * lanes.splat_f32(l.light_color.y),
+            ambient + diffuse * lanes.splat_f32(l.light_color.z),
+        ];
         ShadedLanes {
             color: [
                 base[0] * light[0],
@@ -286,7 +287,12 @@ impl MaterialShader<'_> {
     fn base_color_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 4] {
         let lanes = f.lanes;
         let factor = self.material.base_color_factor.to_array();
-        let mut base = [0, 1, 2, 3].map(|c| lanes.splat_f32(factor[c]) * f.varying(5 + c));
+        let mut base = [
+            lanes.splat_f32(factor[0]) * f.varying(5),
+            lanes.splat_f32(factor[1]) * f.varying(6),
+            lanes.splat_f32(factor[2]) * f.varying(7),
+            lanes.splat_f32(factor[3]) * f.varying(8),
+        ];
         if let Some((texture, sampler)) = self.texture {
             let (u, v) = (f.varying(3).to_array(), f.varying(4).to_array());
             let (du_dx, du_dy) = f.derivatives(3);
@@ -329,11 +335,16 @@ impl MaterialShader<'_> {
             .simd_lt(lanes.splat_f32(f32::INFINITY))
             .and(rcp.simd_gt(lanes.splat_f32(0.0)));
         let zero = lanes.splat_f32(0.0);
-        let mut n = n.map(|c| usable.select_f32(c * rcp, zero));
+        let n = [
+            usable.select_f32(n[0] * rcp, zero),
+            usable.select_f32(n[1] * rcp, zero),
+            usable.select_f32(n[2] * rcp, zero),
+        ];
         if self.material.double_sided && !f.front_facing {
-            n = n.map(|c| -c);
+            [-n[0], -n[1], -n[2]]
+        } else {
+            n
         }
-        n
     }
 
     /// The value of the normals or ids pass, per lane.

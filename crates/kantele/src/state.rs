@@ -134,7 +134,12 @@ impl BlendMode {
             BlendMode::Replace => src,
             BlendMode::PremultipliedOver => {
                 let keep = one - src[3];
-                [0, 1, 2, 3].map(|c| src[c] + dst[c] * keep)
+                [
+                    src[0] + dst[0] * keep,
+                    src[1] + dst[1] * keep,
+                    src[2] + dst[2] * keep,
+                    src[3] + dst[3] * keep,
+                ]
             }
             BlendMode::Alpha => {
                 let a = src[3];
@@ -146,7 +151,12 @@ impl BlendMode {
                     a + dst[3] * keep,
                 ]
             }
-            BlendMode::Additive => [0, 1, 2, 3].map(|c| src[c] + dst[c]),
+            BlendMode::Additive => [
+                src[0] + dst[0],
+                src[1] + dst[1],
+                src[2] + dst[2],
+                src[3] + dst[3],
+            ],
         }
     }
 }

@@ -166,7 +166,7 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 // exact integers (|d| < 2^31), converted to f32 with round-to-nearest-even.
                 let dx =
                     (lanes.splat_i32((pixel_center(x as i64) - v0x) as i32) + lane_offset).to_f32();
-                let dy = splat((pixel_center(y as i64) - v0y) as f32);
+                let dy = lanes.splat_f32((pixel_center(y as i64) - v0y) as f32);
                 let l1 = g1x * dx + g1y * dy;
                 let l2 = g2x * dx + g2y * dy;
                 let l0 = one - l1 - l2;
@@ -209,11 +209,19 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 if kept == 0 {
                     continue;
                 }
-                let dst = tile.color_row(index).map(|plane| lanes.load_f32(plane));
+                let [r, g, b, a] = tile.color_row(index);
+                let dst = [
+                    lanes.load_f32(r),
+                    lanes.load_f32(g),
+                    lanes.load_f32(b),
+                    lanes.load_f32(a),
+                ];
                 let blended = state.blend.blend_lanes(lanes, shaded.color, dst);
-                for (plane, value) in tile.color_row_mut(index).into_iter().zip(blended) {
-                    value.store_masked(keep, plane);
-                }
+                let [r, g, b, a] = tile.color_row_mut(index);
+                blended[0].store_masked(keep, r);
+                blended[1].store_masked(keep, g);
+                blended[2].store_masked(keep, b);
+                blended[3].store_masked(keep, a);
                 if state.depth_write {
                     depth.store_masked(keep, tile.depth_row_mut(index));
                     written_depth_max = written_depth_max.max(

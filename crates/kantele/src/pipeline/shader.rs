@@ -51,7 +51,12 @@ pub trait Shader: Send + Sync {
             }
         }
         ShadedLanes {
-            color: rgba.map(|c| lanes.f32_from_array(c)),
+            color: [
+                lanes.f32_from_array(rgba[0]),
+                lanes.f32_from_array(rgba[1]),
+                lanes.f32_from_array(rgba[2]),
+                lanes.f32_from_array(rgba[3]),
+            ],
             keep: lanes.mask_from_bits(keep),
         }
     }
@@ -209,8 +214,10 @@ impl<'a, L: Lanes> FragmentLanes<'a, L> {
     pub fn varying(&self, index: usize) -> L::F32 {
         let ip = self.interpolation;
         let n = ip.varying_count;
-        let a = |v: usize| self.lanes.splat_f32(ip.attrs[v * n + index]);
-        self.weights[0] * a(0) + self.weights[1] * a(1) + self.weights[2] * a(2)
+        let lanes = self.lanes;
+        self.weights[0] * lanes.splat_f32(ip.attrs[index])
+            + self.weights[1] * lanes.splat_f32(ip.attrs[n + index])
+            + self.weights[2] * lanes.splat_f32(ip.attrs[2 * n + index])
     }
 
     /// Perspective-correct barycentric weights of the triangle's vertices (sum to 1).
@@ -249,7 +256,11 @@ impl<'a, L: Lanes> FragmentLanes<'a, L> {
     #[inline(always)]
     pub(crate) fn per_lane(&self) -> PerLane {
         PerLane {
-            weights: self.weights.map(|w| w.to_array()),
+            weights: [
+                self.weights[0].to_array(),
+                self.weights[1].to_array(),
+                self.weights[2].to_array(),
+            ],
             w: self.w.to_array(),
             depth: self.depth.to_array(),
         }

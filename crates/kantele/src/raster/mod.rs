@@ -206,14 +206,20 @@ pub fn rasterize(
 /// blocks start at two.
 pub const ADAPTIVE_MIN_SIDE: i32 = 2 * BLOCK_SIZE as i32;
 
-/// The paper's adaptive rule: blocks for boxes with aspect 0.4–1.6 that are large enough
-/// ([`ADAPTIVE_MIN_SIDE`]).
+/// The adaptive rule: blocks for boxes with the paper's aspect 0.4–1.6 that are large enough
+/// ([`ADAPTIVE_MIN_SIDE`]), and for every box whose shorter side reaches that size too. The
+/// paper scans thin boxes incrementally whatever their size; here coverage leaves traversal as
+/// block masks, and a full block costs no edge test at all, so a 1300 × 700 box (the thesis'
+/// full-screen quads) is far cheaper in blocks (perf: 47% of the frame in the incremental scan).
 #[inline]
 pub fn prefers_blocks(tri: &TriangleSetup) -> bool {
     let w = tri.bbox.width();
     let h = tri.bbox.height();
     if w < ADAPTIVE_MIN_SIDE && h < ADAPTIVE_MIN_SIDE {
         return false;
+    }
+    if w.min(h) >= ADAPTIVE_MIN_SIDE {
+        return true;
     }
     // 0.4 ≤ w / h ≤ 1.6, in integers: 2h ≤ 5w and 5w ≤ 8h.
     2 * h <= 5 * w && 5 * w <= 8 * h
@@ -573,7 +579,7 @@ mod tests {
     }
 
     #[test]
-    fn adaptive_rule_follows_the_paper() {
+    fn adaptive_rule_uses_blocks_for_large_or_square_boxes() {
         let vp = Viewport::new(100, 100);
         let make = |w: f32, h: f32| {
             setup_triangle(
@@ -589,7 +595,10 @@ mod tests {
             .expect("valid")
         };
         assert!(prefers_blocks(&make(1.0, 1.0)));
+        // 50 × 10 px: thin and short, incremental.
         assert!(!prefers_blocks(&make(1.0, 0.2)));
         assert!(!prefers_blocks(&make(0.1, 0.1)));
+        // 100 × 40 px: outside the paper's aspect range, but both sides span two blocks.
+        assert!(prefers_blocks(&make(2.0, 0.8)));
     }
 }

@@ -44,7 +44,9 @@
 //!   `#[inline(always)]`, the whole kernel body is inlined into that entry point and compiled for
 //!   its instruction set: `a * b` becomes one `vmulps`, with no calls. A kernel method that is
 //!   *not* inlined would fall back to SSE2 code generation and call the intrinsics out of line,
-//!   which is correct but slow, so mark the kernel's `run` and its helpers `#[inline(always)]`.
+//!   which is correct but slow, so mark the kernel's `run` and its helpers `#[inline(always)]`,
+//!   and avoid handing lane code to std helpers in a closure (`[T; N]::map`): LLVM may keep
+//!   such a closure out of line, compiled for the baseline.
 //! - **Bit-identical everywhere, no fused multiply-add.** Every operation gives the same bits on
 //!   every implementation for every input — ±0, ±∞, denormals (no flush-to-zero), huge values,
 //!   NaN — so pictures do not depend on the machine. One exception, which Rust's own `f32`
@@ -75,6 +77,8 @@ use std::sync::OnceLock;
 
 #[cfg(target_arch = "x86_64")]
 mod avx2;
+#[cfg(target_arch = "aarch64")]
+mod neon;
 mod rounding;
 mod scalar;
 #[cfg(target_arch = "x86_64")]
@@ -84,6 +88,8 @@ mod tests;
 
 #[cfg(target_arch = "x86_64")]
 pub use avx2::{Avx2, Avx2F32, Avx2I32, Avx2Mask};
+#[cfg(target_arch = "aarch64")]
+pub use neon::{Neon, NeonF32, NeonI32, NeonMask};
 pub use rounding::{floor, round_ties_even};
 pub use scalar::{Scalar, ScalarF32, ScalarI32, ScalarMask};
 #[cfg(target_arch = "x86_64")]
@@ -93,7 +99,7 @@ pub use sse2::{Sse2, Sse41, SseF32, SseI32, SseLevel, SseMask};
 pub const ISA_ENV: &str = "KANTELE_ISA";
 
 /// Instruction-set levels, from the portable reference to the widest.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Isa {
     /// Plain Rust over arrays: the readable reference, available everywhere.
     Scalar,
@@ -133,7 +139,7 @@ impl Isa {
             Isa::Sse41 => Sse41::new().is_some(),
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => Avx2::new().is_some(),
-            #[cfg(all(target_arch = "aarch64", any()))]
+            #[cfg(target_arch = "aarch64")]
             Isa::Neon => Neon::new().is_some(),
             #[allow(unreachable_patterns)]
             _ => false,
@@ -251,10 +257,10 @@ pub fn dispatch<K: LaneKernel>(isa: Isa, kernel: K) -> K::Output {
                 return kernel.run(token);
             }
         }
-        #[cfg(all(target_arch = "aarch64", any()))]
+        #[cfg(target_arch = "aarch64")]
         Isa::Neon => {
             if let Some(token) = Neon::new() {
-                return neon::run(token, kernel);
+                return kernel.run(token);
             }
         }
         _ => {}

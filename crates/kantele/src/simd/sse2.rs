@@ -21,19 +21,26 @@ use super::{F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
 
 mod sealed {
     /// Only this module's tokens are SSE levels.
-    pub trait Sealed {}
+    pub trait Sealed {
+        /// The token, for methods of lane values (whose existence proves the level available).
+        /// Nothing outside this module can make a [`Proof`], so nothing else can call this.
+        fn token(proof: Proof) -> Self;
+    }
+
+    /// A witness that the caller is a method of this module.
+    pub struct Proof(pub(super) ());
 }
 
 /// An SSE level token: [`Sse2`] or [`Sse41`].
 pub trait SseLevel:
-    sealed::Sealed + Default + Lanes<F32 = SseF32<Self>, I32 = SseI32<Self>, Mask = SseMask<Self>>
+    sealed::Sealed + Lanes<F32 = SseF32<Self>, I32 = SseI32<Self>, Mask = SseMask<Self>>
 {
     /// Whether SSE4.1 instructions may be used.
     const SSE41: bool;
 }
 
 /// The SSE2 implementation's token (SSE2 is part of the x86-64 baseline).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Sse2 {
     _private: (),
 }
@@ -64,16 +71,25 @@ impl Sse41 {
     }
 }
 
-impl Default for Sse41 {
-    /// Only reachable through a value of the SSE4.1 types, which proves detection.
+impl sealed::Sealed for Sse2 {
     #[inline(always)]
-    fn default() -> Sse41 {
+    fn token(_: sealed::Proof) -> Sse2 {
+        Sse2 { _private: () }
+    }
+}
+
+impl sealed::Sealed for Sse41 {
+    #[inline(always)]
+    fn token(_: sealed::Proof) -> Sse41 {
         Sse41 { _detected: () }
     }
 }
 
-impl sealed::Sealed for Sse2 {}
-impl sealed::Sealed for Sse41 {}
+/// The token of `T`, for methods of `T`'s lane values (a value exists, so `T` is available).
+#[inline(always)]
+fn token<T: SseLevel>() -> T {
+    T::token(sealed::Proof(()))
+}
 
 impl SseLevel for Sse2 {
     const SSE41: bool = false;
@@ -186,6 +202,31 @@ fn blend_i<T: SseLevel>(mask: __m128, t: __m128i, f: __m128i) -> __m128i {
         _mm_castsi128_ps(t),
         _mm_castsi128_ps(f)
     )))
+}
+
+// SSE4.1 operations are `#[inline(always)]` functions rather than closures: a closure is a
+// function of its own, compiled without SSE4.1, and if LLVM kept it out of line the intrinsic
+// inside would become a call.
+
+/// `pmulld`; only called where `T::SSE41` holds.
+#[inline(always)]
+fn mullo_sse41<T: SseLevel>(a: __m128i, b: __m128i) -> __m128i {
+    debug_assert!(T::SSE41);
+    sse41!(_mm_mullo_epi32(a, b))
+}
+
+/// `pminsd`; only called where `T::SSE41` holds.
+#[inline(always)]
+fn min_epi32_sse41<T: SseLevel>(a: __m128i, b: __m128i) -> __m128i {
+    debug_assert!(T::SSE41);
+    sse41!(_mm_min_epi32(a, b))
+}
+
+/// `pmaxsd`; only called where `T::SSE41` holds.
+#[inline(always)]
+fn max_epi32_sse41<T: SseLevel>(a: __m128i, b: __m128i) -> __m128i {
+    debug_assert!(T::SSE41);
+    sse41!(_mm_max_epi32(a, b))
 }
 
 /// Rounds to the nearest integer, ties to even (`roundps` semantics for every non-NaN input).
@@ -378,7 +419,7 @@ impl<T: SseLevel> Mul for SseI32<T> {
     #[inline(always)]
     fn mul(self, other: SseI32<T>) -> SseI32<T> {
         if T::SSE41 {
-            return self.zip(other, |a, b| sse41!(_mm_mullo_epi32(a, b)));
+            return self.zip(other, mullo_sse41::<T>);
         }
         // The low 32 bits of the unsigned products are those of the signed ones.
         self.zip(other, |a, b| {
@@ -415,7 +456,7 @@ impl<T: SseLevel> F32x8 for SseF32<T> {
 
     #[inline(always)]
     fn lanes(self) -> T {
-        T::default()
+        token::<T>()
     }
     #[inline(always)]
     fn min(self, other: Self) -> Self {
@@ -482,7 +523,7 @@ impl<T: SseLevel> F32x8 for SseF32<T> {
     #[inline(always)]
     fn store_masked(self, mask: SseMask<T>, out: &mut [f32]) {
         let out = &mut out[..8];
-        let old = T::default().load_f32(out);
+        let old = token::<T>().load_f32(out);
         SseF32::<T>::new(
             blend::<T>(mask.0, self.0, old.0),
             blend::<T>(mask.1, self.1, old.1),
@@ -533,7 +574,7 @@ impl<T: SseLevel> I32x8 for SseI32<T> {
 
     #[inline(always)]
     fn lanes(self) -> T {
-        T::default()
+        token::<T>()
     }
     #[inline(always)]
     fn shl<const N: i32>(self) -> Self {
@@ -553,14 +594,14 @@ impl<T: SseLevel> I32x8 for SseI32<T> {
     #[inline(always)]
     fn min(self, other: Self) -> Self {
         if T::SSE41 {
-            return self.zip(other, |a, b| sse41!(_mm_min_epi32(a, b)));
+            return self.zip(other, min_epi32_sse41::<T>);
         }
         self.simd_gt(other).select_i32(other, self)
     }
     #[inline(always)]
     fn max(self, other: Self) -> Self {
         if T::SSE41 {
-            return self.zip(other, |a, b| sse41!(_mm_max_epi32(a, b)));
+            return self.zip(other, max_epi32_sse41::<T>);
         }
         self.simd_gt(other).select_i32(self, other)
     }
@@ -600,11 +641,11 @@ impl<T: SseLevel> I32x8 for SseI32<T> {
     #[inline(always)]
     fn gather_u32(self, table: &[u32]) -> Self {
         let Some(last) = table.len().checked_sub(1) else {
-            return T::default().splat_i32(0);
+            return token::<T>().splat_i32(0);
         };
         let index = self.to_array();
         let gathered = index.map(|i| table[usize::try_from(i).unwrap_or(0).min(last)] as i32);
-        T::default().i32_from_array(gathered)
+        token::<T>().i32_from_array(gathered)
     }
     #[inline(always)]
     fn extract(self, k: usize) -> i32 {
@@ -624,7 +665,7 @@ impl<T: SseLevel> Mask8 for SseMask<T> {
 
     #[inline(always)]
     fn lanes(self) -> T {
-        T::default()
+        token::<T>()
     }
     #[inline(always)]
     fn and(self, other: Self) -> Self {
@@ -652,7 +693,7 @@ impl<T: SseLevel> Mask8 for SseMask<T> {
     }
     #[inline(always)]
     fn not(self) -> Self {
-        self.xor(T::default().mask_all(true))
+        self.xor(token::<T>().mask_all(true))
     }
     #[inline(always)]
     fn and_not(self, other: Self) -> Self {

@@ -492,6 +492,18 @@ fn avx2_dispatch_runs_avx2_code_where_the_cpu_has_it() {
     }
 }
 
+#[cfg(target_arch = "aarch64")]
+#[test]
+fn neon_dispatch_runs_neon_code() {
+    assert!(Isa::Neon.is_supported(), "every AArch64 CPU has NEON");
+    assert_eq!(dispatch(Isa::Neon, WhichIsa), Isa::Neon);
+    assert_eq!(Isa::best(), Isa::Neon);
+    for isa in [Isa::Sse2, Isa::Sse41, Isa::Avx2] {
+        assert!(!isa.is_supported());
+        assert_eq!(dispatch(isa, WhichIsa), Isa::Scalar);
+    }
+}
+
 #[test]
 fn isa_names_round_trip() {
     for isa in Isa::ALL {
