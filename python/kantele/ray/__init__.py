@@ -92,6 +92,15 @@ def file_names(stem: str, view: int, outputs: Sequence[str]) -> Dict[str, str]:
     return names
 
 
+def peak_rss_mb() -> float:
+    """This process's peak resident memory so far, MiB (Linux and macOS)."""
+    import resource
+    import sys
+
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    return peak / (1024 * 1024) if sys.platform == "darwin" else peak / 1024
+
+
 class Renderer:
     """A ``map_batches`` callable class (a Ray actor): loads each scene once, renders the views
     of a batch with ``Scene.render_many`` and returns their arrays as columns, or, with
@@ -172,6 +181,7 @@ class Renderer:
         columns["files"] = files
         columns["error"] = errors
         columns["worker_pid"] = [os.getpid()] * len(rendered)
+        columns["worker_peak_rss_mb"] = [peak_rss_mb()] * len(rendered)
         return columns
 
 
@@ -234,6 +244,10 @@ def render_files(
             for r in records
         ],
         "errors": sorted({str(r["error"]) for r in failed}),
+        "worker_peak_rss_mb": {
+            str(pid): max(float(r["worker_peak_rss_mb"]) for r in records if r["worker_pid"] == pid)
+            for pid in sorted({int(r["worker_pid"]) for r in records})
+        },
     }
     with open(os.path.join(out_dir, "manifest.json"), "w") as f:
         json.dump(manifest, f, indent=2)
