@@ -37,5 +37,8 @@ for pose in poses:
     color, depth = renderer.render(scene)
 elapsed = time.perf_counter() - start
 print(f"pyrender {n} views: {elapsed:.3f} s, {n / elapsed:.2f} frames/s "
-      f"({color.shape}, {depth.dtype}, {renderer._renderer._platform.__class__.__name__})")
+      f"({color.shape}, {depth.dtype}, {renderer._platform.__class__.__name__})")
+from OpenGL import GL  # noqa: E402
+
+print("GL_RENDERER:", GL.glGetString(GL.GL_RENDERER).decode())
 renderer.delete()
