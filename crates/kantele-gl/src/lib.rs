@@ -418,7 +418,8 @@ impl GlBackend {
             gl.uniform_1_i32(u.base_color_texture.as_ref(), 0);
             gl.active_texture(glow::TEXTURE0);
 
-            for (draw_index, draw) in scene.draws.iter().enumerate() {
+            for draw_index in scene.draw_order(&view.view) {
+                let draw = &scene.draws[draw_index];
                 let mesh = &scene.meshes[draw.mesh];
                 let gpu_mesh = &self.gpu.meshes[draw.mesh];
                 let material = &scene.materials[mesh.material];

@@ -114,7 +114,8 @@ impl Backend for CpuBackend {
             Pass::Normals | Pass::Ids => glam::Vec4::ZERO,
         };
         let mut frame = self.renderer.begin_frame(Some(clear), Some(1.0));
-        for (draw, shader) in scene.draws.iter().zip(&shaders) {
+        for index in scene.draw_order(&view.view) {
+            let (draw, shader) = (&scene.draws[index], &shaders[index]);
             let mesh = &meshes[draw.mesh];
             let state = RenderState {
                 front_face: draw.front_face(),
