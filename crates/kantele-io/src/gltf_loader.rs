@@ -1,7 +1,7 @@
 //! glTF 2.0 (`.gltf` with external or embedded data, `.glb`) by the reference-scene rules.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
@@ -10,23 +10,30 @@ use gltf::mesh::{Mode, Semantic};
 use kantele::scene::{AlphaMode, Camera, Draw, Light, Material, Mesh, Scene, TextureBinding};
 use kantele::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 
+use crate::accessor::{read_f32, read_u32, BufferData};
+use crate::budget::Budget;
+use crate::gltf_patch::{patch, split_glb, Patched};
 use crate::mesh_util::{
     fan_to_list, first_index_out_of_range, flat_normals, framing_camera, strip_to_list,
 };
-use crate::texture_util::decode_srgb;
-use crate::{LoadError, LoadedScene, SceneInfo};
+use crate::read_policy::{read_regular_file, ReadPolicy};
+use crate::texture_util::{decode_srgb_within, image_size, placeholder, ImageError};
+use crate::uri::read_uri;
+use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
 
 /// Extensions whose content the loader uses.
-const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual", "KHR_materials_unlit"];
+pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_unlit",
+    "KHR_mesh_quantization",
+];
 
-/// Extensions that change how geometry or images are stored: without them the file cannot be
-/// read at all, so requiring one is an error.
+/// Extensions that change how geometry or images are stored and that this loader cannot decode:
+/// requiring one is an error (using one without requiring it is refused where it is used).
 const UNREADABLE_EXTENSIONS: &[&str] = &[
     "KHR_draco_mesh_compression",
-    "KHR_mesh_quantization",
     "EXT_meshopt_compression",
     "KHR_texture_basisu",
-    "EXT_texture_webp",
     "EXT_texture_avif",
     "MSFT_texture_dds",
 ];
@@ -34,12 +41,15 @@ const UNREADABLE_EXTENSIONS: &[&str] = &[
 /// Default image size when the scene's extras give none.
 const DEFAULT_RESOLUTION: (u32, u32) = (800, 600);
 
-/// Loads a `.gltf` or `.glb` file.
-pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+/// Loads a `.gltf` or `.glb` file under `options`.
+pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
+    std::fs::metadata(path).map_err(|source| LoadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
+    let invalid = |m: String| LoadError::invalid(path, m);
+    let mut budget = Budget::new(options.max_memory);
+    let bytes = read_regular_file(path, &mut budget).map_err(invalid)?;
     if bytes.is_empty() {
         return Err(LoadError::invalid(path, "the file is empty"));
     }
@@ -47,107 +57,146 @@ pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
         source: path.display().to_string(),
         ..SceneInfo::default()
     };
-    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(&bytes)
-        .map_err(|e| LoadError::invalid(path, format!("not a valid glTF file: {e}")))?;
-    let document = check_extensions(path, document, &mut info)?;
-    let buffers = load_buffers(path, &document, blob)?;
+    let (json, blob) = split_glb(&bytes).map_err(invalid)?;
+    drop(bytes);
+    let mut value: serde_json::Value = serde_json::from_slice(&json)
+        .map_err(|e| invalid(format!("not a valid glTF file: {e}")))?;
+    drop(json);
+    let patched = patch(&mut value).map_err(invalid)?;
+    for w in &patched.warnings {
+        info.warn(w.clone());
+    }
+    if patched.animations > 0 {
+        info.ignore("animations");
+    }
+    let root: gltf::json::Root = serde_json::from_value(value)
+        .map_err(|e| invalid(format!("not a valid glTF file: {e}")))?;
+    let document = check_extensions(path, root, &mut info)?;
+    let policy = ReadPolicy::new(path, &options.allow_read);
+    let buffers = load_buffers(path, &document, blob, &policy, &mut budget)?;
+    let decoded_views = HashMap::new();
     Loader {
         path,
         document: &document,
         buffers: &buffers,
+        decoded_views: &decoded_views,
+        options,
+        policy: &policy,
+        budget,
+        patched,
         scene: Scene::default(),
         info,
         image_textures: HashMap::new(),
+        encoded_images: HashMap::new(),
         primitive_meshes: HashMap::new(),
         default_material: None,
     }
     .run()
 }
 
-/// Records the extensions, rejects required ones that cannot be read, and validates the document
-/// (without the unsupported required extensions, which are tried anyway with a warning).
+/// Records the extensions and validates the document. What cannot be decoded at all was
+/// refused while patching; other unsupported extensions give a warning (and the picture may
+/// lack what they add).
 fn check_extensions(
     path: &Path,
-    document: gltf::Document,
+    mut json: gltf::json::Root,
     info: &mut SceneInfo,
 ) -> Result<gltf::Document, LoadError> {
-    info.extensions_used = document.extensions_used().map(String::from).collect();
-    for ext in document.extensions_required() {
-        if UNREADABLE_EXTENSIONS.contains(&ext) {
+    info.extensions_used = json.extensions_used.clone();
+    for ext in &json.extensions_required {
+        if UNREADABLE_EXTENSIONS.contains(&ext.as_str()) {
             return Err(LoadError::invalid(
                 path,
-                format!("the file requires extension {ext}, which this loader cannot read"),
+                format!("the file requires extension {ext}, which this loader cannot decode"),
             ));
         }
-        if !SUPPORTED_EXTENSIONS.contains(&ext) {
+        if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
             info.warn(format!(
                 "the file requires unsupported extension {ext}; loading it anyway, the picture may be wrong"
             ));
         }
     }
-    for ext in &info.extensions_used.clone() {
+    for ext in &json.extensions_used {
         if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
-            info.warn(format!("extension {ext} is not supported and is ignored"));
+            info.ignore(ext.clone());
         }
     }
-    let mut json = document.into_json();
-    json.extensions_required
-        .retain(|e| SUPPORTED_EXTENSIONS.contains(&e.as_str()));
+    // Handled above: the crate's own list of supported extensions must not reject the file.
+    json.extensions_required.clear();
     validate(path, json, info)
 }
 
-/// Validates the document. Missing `min` / `max` on POSITION accessors (required by the spec,
-/// often left out by hand-written files, and unused here) only give a warning.
+/// Validates the document. Errors that the glTF spec allows or that this loader handles
+/// itself are let through: missing `min` / `max` on POSITION accessors (a warning), accessors
+/// without a buffer view (zero-filled) and textures without a source (drawn untextured).
 fn validate(
     path: &Path,
     json: gltf::json::Root,
     info: &mut SceneInfo,
 ) -> Result<gltf::Document, LoadError> {
-    match gltf::Document::from_json(json.clone()) {
-        Ok(document) => Ok(document),
-        Err(gltf::Error::Validation(errors)) => {
-            let harmless = |(p, e): &(gltf::json::Path, gltf::json::validation::Error)| {
-                matches!(e, gltf::json::validation::Error::Missing)
-                    && (p.0.ends_with("[\"POSITION\"].min") || p.0.ends_with("[\"POSITION\"].max"))
-            };
-            if errors.iter().all(harmless) {
-                info.warn("POSITION accessors lack the min / max the glTF spec requires");
-                Ok(gltf::Document::from_json_without_validation(json))
-            } else {
-                let list: Vec<String> = errors
-                    .iter()
-                    .filter(|e| !harmless(e))
-                    .map(|(p, e)| format!("{p}: {e}"))
-                    .collect();
-                Err(LoadError::invalid(
-                    path,
-                    format!("invalid glTF: {}", list.join("; ")),
-                ))
+    use gltf::json::validation::{Error, Validate};
+    let mut errors = Vec::new();
+    json.validate(&json, gltf::json::Path::new, &mut |p, e| {
+        errors.push((p(), e))
+    });
+    let mut min_max_missing = false;
+    let fatal: Vec<String> = errors
+        .iter()
+        .filter(|(p, e)| {
+            let p = p.as_str();
+            let missing = matches!(e, Error::Missing);
+            if missing && (p.ends_with("[\"POSITION\"].min") || p.ends_with("[\"POSITION\"].max")) {
+                min_max_missing = true;
+                return false;
             }
-        }
-        Err(e) => Err(LoadError::invalid(path, e.to_string())),
+            let handled = missing
+                && ((p.starts_with("accessors[") && p.ends_with("].bufferView"))
+                    || (p.starts_with("textures[") && p.ends_with("].source")));
+            !handled
+        })
+        .map(|(p, e)| format!("{p}: {e}"))
+        .collect();
+    if !fatal.is_empty() {
+        return Err(LoadError::invalid(
+            path,
+            format!("invalid glTF: {}", fatal.join("; ")),
+        ));
     }
+    if min_max_missing {
+        info.warn("POSITION accessors lack the min / max the glTF spec requires");
+    }
+    Ok(gltf::Document::from_json_without_validation(json))
 }
 
-/// Reads every buffer: the GLB binary chunk, external files or data URIs.
+/// Reads every buffer: the GLB binary chunk, external files or data URIs. Fallback buffers of
+/// `EXT_meshopt_compression` that have no data stay empty.
 fn load_buffers(
     path: &Path,
     document: &gltf::Document,
     mut blob: Option<Vec<u8>>,
+    policy: &ReadPolicy,
+    budget: &mut Budget,
 ) -> Result<Vec<Vec<u8>>, LoadError> {
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
         let what = format!("buffer {}", buffer.index());
+        let fallback = buffer
+            .extension_value("EXT_meshopt_compression")
+            .and_then(|v| v.get("fallback"))
+            .and_then(serde_json::Value::as_bool)
+            == Some(true);
         let data = match buffer.source() {
+            gltf::buffer::Source::Bin if fallback => Vec::new(),
             gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
                 LoadError::invalid(
                     path,
                     format!("{what} refers to the binary chunk, which the file lacks"),
                 )
             })?,
-            gltf::buffer::Source::Uri(uri) => read_uri(path, uri, &what)?,
+            gltf::buffer::Source::Uri(uri) => read_uri(path, uri, policy, budget)
+                .map_err(|e| LoadError::invalid(path, format!("{what}: {e}")))?,
         };
-        if data.len() < buffer.length() {
+        if data.len() < buffer.length() && !fallback {
             return Err(LoadError::invalid(
                 path,
                 format!(
@@ -162,108 +211,24 @@ fn load_buffers(
     Ok(buffers)
 }
 
-/// Reads the data an URI refers to: a `data:` URI, or a file relative to the glTF file.
-fn read_uri(path: &Path, uri: &str, what: &str) -> Result<Vec<u8>, LoadError> {
-    if let Some(rest) = uri.strip_prefix("data:") {
-        let Some((_, payload)) = rest.split_once(";base64,") else {
-            return Err(LoadError::invalid(
-                path,
-                format!("{what}: only base64 data URIs are supported"),
-            ));
-        };
-        return decode_base64(payload).ok_or_else(|| {
-            LoadError::invalid(path, format!("{what}: the data URI is not valid base64"))
-        });
-    }
-    let file: PathBuf = if let Some(rest) = uri.strip_prefix("file://") {
-        PathBuf::from(percent_decode(rest))
-    } else if uri.contains(':') && !looks_like_windows_path(uri) {
-        return Err(LoadError::invalid(
-            path,
-            format!("{what}: unsupported URI '{uri}' (only relative files and data URIs)"),
-        ));
-    } else {
-        path.parent()
-            .unwrap_or(Path::new(""))
-            .join(percent_decode(uri))
-    };
-    std::fs::read(&file).map_err(|e| {
-        LoadError::invalid(
-            path,
-            format!("{what}: cannot read file {}: {e}", file.display()),
-        )
-    })
-}
-
-fn looks_like_windows_path(uri: &str) -> bool {
-    let b = uri.as_bytes();
-    b.len() > 2 && b[0].is_ascii_alphabetic() && b[1] == b':' && (b[2] == b'/' || b[2] == b'\\')
-}
-
-/// Decodes `%XX` escapes (URIs in glTF are percent-encoded); malformed escapes stay as they are.
-fn percent_decode(s: &str) -> String {
-    let bytes = s.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' && i + 2 < bytes.len() {
-            let hex = std::str::from_utf8(&bytes[i + 1..i + 3])
-                .ok()
-                .and_then(|h| u8::from_str_radix(h, 16).ok());
-            if let Some(byte) = hex {
-                out.push(byte);
-                i += 3;
-                continue;
-            }
-        }
-        out.push(bytes[i]);
-        i += 1;
-    }
-    String::from_utf8_lossy(&out).into_owned()
-}
-
-/// Standard base64 (RFC 4648, padding optional, whitespace ignored); `None` on a bad character.
-fn decode_base64(s: &str) -> Option<Vec<u8>> {
-    fn value(c: u8) -> Option<u32> {
-        Some(match c {
-            b'A'..=b'Z' => c - b'A',
-            b'a'..=b'z' => c - b'a' + 26,
-            b'0'..=b'9' => c - b'0' + 52,
-            b'+' | b'-' => 62,
-            b'/' | b'_' => 63,
-            _ => return None,
-        } as u32)
-    }
-    let mut out = Vec::with_capacity(s.len() / 4 * 3);
-    let mut acc = 0u32;
-    let mut bits = 0;
-    for c in s.bytes() {
-        if c == b'=' {
-            break;
-        }
-        if c.is_ascii_whitespace() {
-            continue;
-        }
-        acc = (acc << 6) | value(c)?;
-        bits += 6;
-        if bits >= 8 {
-            bits -= 8;
-            out.push((acc >> bits) as u8);
-            acc &= (1 << bits) - 1;
-        }
-    }
-    Some(out)
-}
-
 /// Converts a glTF document to a [`Scene`].
 struct Loader<'a> {
     path: &'a Path,
     document: &'a gltf::Document,
     buffers: &'a [Vec<u8>],
+    /// `EXT_meshopt_compression` buffer views, decoded.
+    decoded_views: &'a HashMap<usize, Vec<u8>>,
+    options: &'a LoadOptions,
+    policy: &'a ReadPolicy,
+    budget: Budget,
+    /// What patching the JSON found (the image each texture shows).
+    patched: Patched,
     scene: Scene,
     info: SceneInfo,
-    /// glTF image index → index into `scene.textures`.
-    image_textures: HashMap<usize, usize>,
+    /// glTF image index → index into `scene.textures` (`None`: it could not be loaded).
+    image_textures: HashMap<usize, Option<usize>>,
+    /// Encoded image bytes → index into `scene.textures`: identical sources decode once.
+    encoded_images: HashMap<Vec<u8>, usize>,
     /// (glTF mesh, primitive) → index into `scene.meshes` (`None`: not drawable, skipped).
     primitive_meshes: HashMap<(usize, usize), Option<usize>>,
     /// Index of the appended default material, once one was needed.
@@ -295,12 +260,7 @@ impl Loader<'_> {
             self.scene.materials.push(converted);
         }
         if document.skins().len() > 0 {
-            self.info
-                .warn("skins are not supported; meshes are drawn in their bind pose");
-        }
-        if document.animations().len() > 0 {
-            self.info
-                .warn("animations are not supported and are ignored");
+            self.info.ignore("skins (meshes drawn in their bind pose)");
         }
 
         let Some(gltf_scene) = document
@@ -346,15 +306,12 @@ impl Loader<'_> {
                             });
                         }
                     }
-                    _ => self
-                        .info
-                        .warn("point and spot lights are not supported and are ignored"),
+                    _ => self.info.ignore("point and spot lights"),
                 }
             }
             if let Some(mesh) = node.mesh() {
-                if node.skin().is_some() || mesh.weights().is_some() {
-                    self.info
-                        .warn("skinning and morph targets are not supported; drawn without them");
+                if node.skin().is_some() {
+                    self.info.ignore("skins (meshes drawn in their bind pose)");
                 }
                 for primitive in mesh.primitives() {
                     let key = (mesh.index(), primitive.index());
@@ -489,9 +446,7 @@ impl Loader<'_> {
                 })
             }
             gltf::camera::Projection::Orthographic(_) => {
-                self.info.warn(format!(
-                    "orthographic camera '{name}' is not supported; ignored"
-                ));
+                self.info.ignore(format!("orthographic camera '{name}'"));
                 None
             }
         }
@@ -533,16 +488,25 @@ impl Loader<'_> {
             ));
             return Ok(None);
         }
-        let image = texture.source();
-        let texture_index = match self.image_textures.get(&image.index()) {
+        let Some(image_index) = self
+            .patched
+            .texture_images
+            .get(texture.index())
+            .copied()
+            .flatten()
+        else {
+            return Ok(None);
+        };
+        let texture_index = match self.image_textures.get(&image_index) {
             Some(&t) => t,
             None => {
-                let decoded = self.image(&image)?;
-                self.scene.textures.push(Arc::new(decoded));
-                let t = self.scene.textures.len() - 1;
-                self.image_textures.insert(image.index(), t);
+                let t = self.image(image_index)?;
+                self.image_textures.insert(image_index, t);
                 t
             }
+        };
+        let Some(texture_index) = texture_index else {
+            return Ok(None);
         };
         let s = texture.sampler();
         let wrap = |mode| match mode {
@@ -580,31 +544,79 @@ impl Loader<'_> {
         }))
     }
 
-    /// Decodes one glTF image as an sRGB texture.
-    fn image(&mut self, image: &gltf::Image) -> Result<Texture, LoadError> {
-        let mut what = format!("image {}", image.index());
+    /// Loads one glTF image as an sRGB texture into the scene (once per distinct encoded
+    /// image); `None` when it is missing or cannot be decoded and the load is not strict (a
+    /// warning says so). Budget overruns are always errors.
+    fn image(&mut self, index: usize) -> Result<Option<usize>, LoadError> {
+        let Some(image) = self.document.images().nth(index) else {
+            return Ok(None);
+        };
+        let mut what = format!("image {index}");
         if let Some(name) = image.name() {
             what = format!("{what} ('{name}')");
         }
-        let (bytes, mime_type) = match image.source() {
+        let loaded = match image.source() {
             gltf::image::Source::View { view, mime_type } => {
-                let data = self
-                    .buffers
-                    .get(view.buffer().index())
-                    .and_then(|b| b.get(view.offset()..view.offset().checked_add(view.length())?))
-                    .ok_or_else(|| {
-                        self.invalid(format!("{what}: its buffer view lies outside the buffer"))
-                    })?;
-                (data.to_vec(), Some(mime_type))
+                let data = BufferData {
+                    buffers: self.buffers,
+                    decoded_views: self.decoded_views,
+                };
+                data.view(&view)
+                    .map(|b| (b.to_vec(), Some(mime_type.to_string())))
             }
             gltf::image::Source::Uri { uri, mime_type } => {
                 if !uri.starts_with("data:") {
                     what = format!("{what} from '{uri}'");
                 }
-                (read_uri(self.path, uri, &what)?, mime_type)
+                read_uri(self.path, uri, self.policy, &mut self.budget)
+                    .map(|b| (b, mime_type.map(str::to_string)))
             }
         };
-        decode_srgb(&bytes, mime_type).map_err(|e| self.invalid(format!("{what}: {e}")))
+        let (bytes, mime_type) = match loaded {
+            Ok(loaded) => loaded,
+            Err(e) if e.contains("memory budget") => {
+                return Err(self.invalid(format!("{what}: {e}")))
+            }
+            Err(e) => return self.texture_problem(format!("{what}: {e}")),
+        };
+        if let Some(&t) = self.encoded_images.get(&bytes) {
+            return Ok(Some(t));
+        }
+        let size = match image_size(&bytes, mime_type.as_deref()) {
+            Ok(size) => size,
+            Err(ImageError::Budget(e) | ImageError::Decode(e)) => {
+                return self.texture_problem(format!("{what}: {e}"))
+            }
+        };
+        if !self.options.decode_textures {
+            // Describing the scene: the header's size is reported, nothing is decoded.
+            return Ok(Some(self.push_texture(placeholder(), bytes, size)));
+        }
+        match decode_srgb_within(&bytes, mime_type.as_deref(), &mut self.budget) {
+            Ok(texture) => Ok(Some(self.push_texture(texture, bytes, size))),
+            Err(ImageError::Budget(e)) => Err(self.invalid(format!("{what}: {e}"))),
+            Err(ImageError::Decode(e)) => self.texture_problem(format!("{what}: {e}")),
+        }
+    }
+
+    fn push_texture(&mut self, texture: Texture, encoded: Vec<u8>, size: (u32, u32)) -> usize {
+        self.scene.textures.push(Arc::new(texture));
+        self.info.texture_sizes.push(size);
+        let t = self.scene.textures.len() - 1;
+        self.encoded_images.insert(encoded, t);
+        t
+    }
+
+    /// A texture that cannot be loaded: an error when strict, otherwise a warning and no
+    /// texture.
+    fn texture_problem(&mut self, message: String) -> Result<Option<usize>, LoadError> {
+        if self.options.strict {
+            return Err(self.invalid(message));
+        }
+        self.info.warn(format!(
+            "{message}; drawn untextured (--strict makes this an error)"
+        ));
+        Ok(None)
     }
 
     fn default_material(&mut self) -> usize {
@@ -633,26 +645,21 @@ impl Loader<'_> {
             return Ok(None);
         }
         if primitive.morph_targets().len() > 0 {
-            self.info
-                .warn("skinning and morph targets are not supported; drawn without them");
+            self.info.ignore("morph targets");
         }
 
-        let accessor_error = |semantic: &str, index: usize| {
-            format!("{what}: {semantic} accessor {index} cannot be read (it lies outside its buffer or has no data)")
-        };
         let check = |semantic: &str,
                      accessor: &gltf::Accessor,
-                     types: &[DataType],
-                     dims: &[Dimensions],
-                     normalized_ints: bool|
+                     allowed: &[(DataType, bool)],
+                     dims: &[Dimensions]|
          -> Result<(), LoadError> {
             let ty = accessor.data_type();
-            let ok_type = types.contains(&ty)
-                && dims.contains(&accessor.dimensions())
-                && (!normalized_ints || ty == DataType::F32 || accessor.normalized());
+            let normalized = accessor.normalized() && ty != DataType::F32;
+            let ok_type =
+                allowed.contains(&(ty, normalized)) && dims.contains(&accessor.dimensions());
             if !ok_type {
                 return Err(self.invalid(format!(
-                    "{what}: {semantic} accessor {} has type {:?} {:?}{}, which glTF does not allow",
+                    "{what}: {semantic} accessor {} has type {:?} {:?}{}, which glTF (with KHR_mesh_quantization) does not allow",
                     accessor.index(),
                     ty,
                     accessor.dimensions(),
@@ -667,6 +674,22 @@ impl Loader<'_> {
             }
             Ok(())
         };
+        use DataType::{F32, I16, I8, U16, U32, U8};
+        // Types of glTF 2.0 plus KHR_mesh_quantization, as (component type, normalized).
+        let any_int = [
+            (F32, false),
+            (I8, false),
+            (I8, true),
+            (U8, false),
+            (U8, true),
+            (I16, false),
+            (I16, true),
+            (U16, false),
+            (U16, true),
+        ];
+        let normal_types = [(F32, false), (I8, true), (I16, true)];
+        let color_types = [(F32, false), (U8, true), (U16, true)];
+        let index_types = [(U8, false), (U16, false), (U32, false)];
 
         let Some(position_accessor) = primitive.get(&Semantic::Positions) else {
             return Err(self.invalid(format!("{what} has no POSITION attribute")));
@@ -674,124 +697,108 @@ impl Loader<'_> {
         check(
             "POSITION",
             &position_accessor,
-            &[DataType::F32],
+            &any_int,
             &[Dimensions::Vec3],
-            false,
         )?;
         let normal_accessor = primitive.get(&Semantic::Normals);
         if let Some(a) = &normal_accessor {
-            check("NORMAL", a, &[DataType::F32], &[Dimensions::Vec3], false)?;
+            check("NORMAL", a, &normal_types, &[Dimensions::Vec3])?;
         }
         let texcoord_accessor = primitive.get(&Semantic::TexCoords(0));
         if let Some(a) = &texcoord_accessor {
-            check(
-                "TEXCOORD_0",
-                a,
-                &[DataType::F32, DataType::U8, DataType::U16],
-                &[Dimensions::Vec2],
-                true,
-            )?;
+            check("TEXCOORD_0", a, &any_int, &[Dimensions::Vec2])?;
         }
         let color_accessor = primitive.get(&Semantic::Colors(0));
         if let Some(a) = &color_accessor {
             check(
                 "COLOR_0",
                 a,
-                &[DataType::F32, DataType::U8, DataType::U16],
+                &color_types,
                 &[Dimensions::Vec3, Dimensions::Vec4],
-                true,
             )?;
         }
         let index_accessor = primitive.indices();
         if let Some(a) = &index_accessor {
-            check(
-                "index",
-                a,
-                &[DataType::U8, DataType::U16, DataType::U32],
-                &[Dimensions::Scalar],
-                false,
-            )?;
+            check("index", a, &index_types, &[Dimensions::Scalar])?;
         }
 
-        let buffers = self.buffers;
-        let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| self.invalid(accessor_error("POSITION", position_accessor.index())))?
-            .map(Vec3::from)
-            .collect();
-        let n = positions.len();
-        let count_error = |semantic: &str, len: usize| {
-            self.invalid(format!(
-                "{what}: {semantic} has {len} elements but POSITION has {n}"
-            ))
+        let data = BufferData {
+            buffers: self.buffers,
+            decoded_views: self.decoded_views,
         };
-        if n != position_accessor.count() {
-            return Err(self.invalid(accessor_error("POSITION", position_accessor.index())));
-        }
+        let n = position_accessor.count();
+        let mut read = |semantic: &str, accessor: &gltf::Accessor| {
+            let label = format!("{what}: {semantic} accessor {}", accessor.index());
+            read_f32(&data, accessor, &mut self.budget, &label)
+        };
+        let positions: Vec<Vec3> = read("POSITION", &position_accessor)
+            .map_err(|e| LoadError::invalid(self.path, e))?
+            .chunks_exact(3)
+            .map(Vec3::from_slice)
+            .collect();
+        let count_error = |semantic: &str, len: usize| {
+            LoadError::invalid(
+                self.path,
+                format!("{what}: {semantic} has {len} elements but POSITION has {n}"),
+            )
+        };
         let normals = match &normal_accessor {
-            Some(a) => {
-                let normals: Vec<Vec3> = reader
-                    .read_normals()
-                    .ok_or_else(|| self.invalid(accessor_error("NORMAL", a.index())))?
-                    .map(Vec3::from)
-                    .collect();
-                if normals.len() != n {
-                    return Err(count_error("NORMAL", normals.len()));
-                }
-                Some(normals)
-            }
+            Some(a) if a.count() != n => return Err(count_error("NORMAL", a.count())),
+            Some(a) => Some(
+                read("NORMAL", a)
+                    .map_err(|e| LoadError::invalid(self.path, e))?
+                    .chunks_exact(3)
+                    .map(Vec3::from_slice)
+                    .collect::<Vec<_>>(),
+            ),
             None => None,
         };
         let texcoords = match &texcoord_accessor {
-            Some(a) => {
-                let texcoords: Vec<Vec2> = reader
-                    .read_tex_coords(0)
-                    .ok_or_else(|| self.invalid(accessor_error("TEXCOORD_0", a.index())))?
-                    .into_f32()
-                    .map(Vec2::from)
-                    .collect();
-                if texcoords.len() != n {
-                    return Err(count_error("TEXCOORD_0", texcoords.len()));
-                }
-                Some(texcoords)
-            }
+            Some(a) if a.count() != n => return Err(count_error("TEXCOORD_0", a.count())),
+            Some(a) => Some(
+                read("TEXCOORD_0", a)
+                    .map_err(|e| LoadError::invalid(self.path, e))?
+                    .chunks_exact(2)
+                    .map(Vec2::from_slice)
+                    .collect::<Vec<_>>(),
+            ),
             None => None,
         };
         let colors = match &color_accessor {
+            Some(a) if a.count() != n => return Err(count_error("COLOR_0", a.count())),
             Some(a) => {
-                let colors: Vec<Vec4> = reader
-                    .read_colors(0)
-                    .ok_or_else(|| self.invalid(accessor_error("COLOR_0", a.index())))?
-                    .into_rgba_f32()
-                    .map(Vec4::from)
-                    .collect();
-                if colors.len() != n {
-                    return Err(count_error("COLOR_0", colors.len()));
-                }
-                Some(colors)
+                let flat = read("COLOR_0", a).map_err(|e| LoadError::invalid(self.path, e))?;
+                Some(if a.dimensions() == Dimensions::Vec3 {
+                    flat.chunks_exact(3)
+                        .map(|c| Vec4::new(c[0], c[1], c[2], 1.0))
+                        .collect::<Vec<_>>()
+                } else {
+                    flat.chunks_exact(4).map(Vec4::from_slice).collect()
+                })
             }
             None => None,
         };
         let vertex_indices: Vec<u32> = match &index_accessor {
             Some(a) => {
-                let indices: Vec<u32> = reader
-                    .read_indices()
-                    .ok_or_else(|| self.invalid(accessor_error("index", a.index())))?
-                    .into_u32()
-                    .collect();
-                if indices.len() != a.count() {
-                    return Err(self.invalid(accessor_error("index", a.index())));
-                }
-                indices
+                let label = format!("{what}: index accessor {}", a.index());
+                read_u32(&data, a, &mut self.budget, &label)
+                    .map_err(|e| LoadError::invalid(self.path, e))?
             }
             None => {
                 let n = u32::try_from(n).map_err(|_| {
                     self.invalid(format!("{what}: too many vertices for 32-bit indices"))
                 })?;
+                self.budget
+                    .charge(n as u64, 4, &what)
+                    .map_err(|e| LoadError::invalid(self.path, e))?;
                 (0..n).collect()
             }
         };
+        if positions.iter().any(|p| !p.is_finite()) {
+            self.info.warn(format!(
+                "{what}: some positions are infinite or NaN; triangles using them are not drawn"
+            ));
+        }
         let indices = match mode {
             Mode::TriangleStrip => strip_to_list(&vertex_indices),
             Mode::TriangleFan => fan_to_list(&vertex_indices),
@@ -836,27 +843,5 @@ fn named(name: Option<&str>, kind: &str, index: usize) -> String {
     match name {
         Some(n) if !n.is_empty() => n.to_string(),
         _ => format!("{kind} {index}"),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn base64_round_trip() {
-        assert_eq!(decode_base64("aGVsbG8=").unwrap(), b"hello");
-        assert_eq!(decode_base64("aGVsbG8").unwrap(), b"hello");
-        assert_eq!(decode_base64("AAECAwQF").unwrap(), vec![0, 1, 2, 3, 4, 5]);
-        assert_eq!(decode_base64("").unwrap(), Vec::<u8>::new());
-        assert!(decode_base64("a*b").is_none());
-    }
-
-    #[test]
-    fn percent_decoding() {
-        assert_eq!(percent_decode("my%20file.png"), "my file.png");
-        assert_eq!(percent_decode("100%"), "100%");
-        assert_eq!(percent_decode("%zz%4"), "%zz%4");
-        assert_eq!(percent_decode("%C3%A4.bin"), "ä.bin");
     }
 }

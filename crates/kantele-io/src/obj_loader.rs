@@ -6,24 +6,29 @@ use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use kantele::scene::{AlphaMode, Draw, Light, Material, Mesh, Scene, TextureBinding};
+use kantele::shade::texture::Texture;
 
+use crate::budget::Budget;
 use crate::mesh_util::{first_index_out_of_range, flat_normals, framing_camera};
-use crate::texture_util::{decode_srgb, trilinear_repeat};
-use crate::{LoadError, LoadedScene, SceneInfo};
+use crate::read_policy::ReadPolicy;
+use crate::texture_util::{
+    decode_srgb_within, image_size, placeholder, trilinear_repeat, ImageError,
+};
+use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
 
 /// Loads an `.obj` file and the materials of its `.mtl` libraries.
-pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
+pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
     // tobj reports a missing file only as "open file failed": look first, for a proper message.
     std::fs::metadata(path).map_err(|source| LoadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    let options = tobj::LoadOptions {
+    let tobj_options = tobj::LoadOptions {
         triangulate: true,
         single_index: true,
         ..Default::default()
     };
-    let (models, materials) = tobj::load_obj(path, &options)
+    let (models, materials) = tobj::load_obj(path, &tobj_options)
         .map_err(|e| LoadError::invalid(path, format!("not a valid OBJ file: {e}")))?;
     let mut info = SceneInfo {
         source: path.display().to_string(),
@@ -45,7 +50,9 @@ pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
             Vec::new()
         }
     };
-    let mut texture_files: HashMap<String, usize> = HashMap::new();
+    let policy = ReadPolicy::new(path, &options.allow_read);
+    let mut budget = Budget::new(options.max_memory);
+    let mut texture_files: HashMap<String, Option<usize>> = HashMap::new();
     for m in &materials {
         let base_color_texture = match m.diffuse_texture.as_deref().map(str::trim) {
             Some(name) if !name.is_empty() => {
@@ -53,28 +60,31 @@ pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
                     Some(&t) => t,
                     None => {
                         let file = directory.join(name.replace('\\', "/"));
-                        let bytes = std::fs::read(&file).map_err(|e| {
-                            LoadError::invalid(
-                                path,
-                                format!(
-                                    "material '{}': cannot read texture {}: {e}",
-                                    m.name,
-                                    file.display()
-                                ),
-                            )
-                        })?;
-                        let decoded = decode_srgb(&bytes, None).map_err(|e| {
-                            LoadError::invalid(
-                                path,
-                                format!("material '{}': texture {}: {e}", m.name, file.display()),
-                            )
-                        })?;
-                        scene.textures.push(Arc::new(decoded));
-                        texture_files.insert(name.to_string(), scene.textures.len() - 1);
-                        scene.textures.len() - 1
+                        let what = format!("material '{}': texture {}", m.name, file.display());
+                        let t = match load_texture(&file, &policy, &mut budget, options) {
+                            Ok(texture) => {
+                                scene.textures.push(Arc::new(texture.0));
+                                info.texture_sizes.push(texture.1);
+                                Some(scene.textures.len() - 1)
+                            }
+                            Err(ImageError::Budget(e)) => {
+                                return Err(LoadError::invalid(path, format!("{what}: {e}")))
+                            }
+                            Err(ImageError::Decode(e)) if options.strict => {
+                                return Err(LoadError::invalid(path, format!("{what}: {e}")))
+                            }
+                            Err(ImageError::Decode(e)) => {
+                                info.warn(format!(
+                                    "{what}: {e}; drawn untextured (--strict makes this an error)"
+                                ));
+                                None
+                            }
+                        };
+                        texture_files.insert(name.to_string(), t);
+                        t
                     }
                 };
-                Some(TextureBinding {
+                texture.map(|texture| TextureBinding {
                     texture,
                     sampler: trilinear_repeat(),
                 })
@@ -191,4 +201,26 @@ pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
         .validate()
         .map_err(|e| LoadError::invalid(path, e.to_string()))?;
     Ok(LoadedScene { scene, info })
+}
+
+/// Reads and decodes a texture file under the read policy and budget (a placeholder when
+/// textures are not decoded); with its header size.
+fn load_texture(
+    file: &Path,
+    policy: &ReadPolicy,
+    budget: &mut Budget,
+    options: &LoadOptions,
+) -> Result<(Texture, (u32, u32)), ImageError> {
+    let bytes = policy.read(file, budget).map_err(|e| {
+        if e.contains("memory budget") {
+            ImageError::Budget(e)
+        } else {
+            ImageError::Decode(e)
+        }
+    })?;
+    let size = image_size(&bytes, None)?;
+    if !options.decode_textures {
+        return Ok((placeholder(), size));
+    }
+    Ok((decode_srgb_within(&bytes, None, budget)?, size))
 }
