@@ -4,7 +4,7 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::sync::Arc;
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use glam::{Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use kantele::scene::{AlphaMode, Camera, Draw, Light, Material, Mesh, Scene, TextureBinding};
@@ -26,6 +26,10 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_lights_punctual",
     "KHR_materials_unlit",
     "KHR_mesh_quantization",
+    "KHR_texture_transform",
+    "KHR_materials_emissive_strength",
+    "EXT_mesh_gpu_instancing",
+    "EXT_texture_webp",
 ];
 
 /// Extensions that change how geometry or images are stored and that this loader cannot decode:
@@ -90,6 +94,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         encoded_images: HashMap::new(),
         primitive_meshes: HashMap::new(),
         default_material: None,
+        material_uv: Vec::new(),
     }
     .run()
 }
@@ -229,10 +234,59 @@ struct Loader<'a> {
     image_textures: HashMap<usize, Option<usize>>,
     /// Encoded image bytes → index into `scene.textures`: identical sources decode once.
     encoded_images: HashMap<Vec<u8>, usize>,
-    /// (glTF mesh, primitive) → index into `scene.meshes` (`None`: not drawable, skipped).
-    primitive_meshes: HashMap<(usize, usize), Option<usize>>,
+    /// (glTF mesh, primitive, morph weights' bits) → index into `scene.meshes` (`None`: not
+    /// drawable, skipped).
+    primitive_meshes: HashMap<(usize, usize, Vec<u32>), Option<usize>>,
     /// Index of the appended default material, once one was needed.
     default_material: Option<usize>,
+    /// Per file material: the texture coordinates its textures read.
+    material_uv: Vec<Option<UvMap>>,
+}
+
+/// Which texture coordinates a material's textures read: a `TEXCOORD_n` set and a
+/// `KHR_texture_transform` (applied to the mesh's coordinates at load).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct UvMap {
+    set: u32,
+    transform: Mat3,
+}
+
+impl UvMap {
+    fn of(info: &gltf::texture::Info) -> Self {
+        let mut set = info.tex_coord();
+        let mut transform = Mat3::IDENTITY;
+        if let Some(t) = info.extension_value("KHR_texture_transform") {
+            let pair = |key: &str, default: Vec2| {
+                t.get(key)
+                    .and_then(|v| v.as_array())
+                    .and_then(|a| {
+                        Some(Vec2::new(
+                            a.first()?.as_f64()? as f32,
+                            a.get(1)?.as_f64()? as f32,
+                        ))
+                    })
+                    .unwrap_or(default)
+            };
+            let offset = pair("offset", Vec2::ZERO);
+            let scale = pair("scale", Vec2::ONE);
+            let rotation = t.get("rotation").and_then(|v| v.as_f64()).unwrap_or(0.0) as f32;
+            // uv' = T × R × S × uv, the matrices exactly as the extension's GLSL writes them
+            // (column-major: R's columns are (cos, sin) and (−sin, cos)).
+            let (sin, cos) = rotation.sin_cos();
+            let translation = Mat3::from_cols(Vec3::X, Vec3::Y, offset.extend(1.0));
+            let rotation =
+                Mat3::from_cols(Vec3::new(cos, sin, 0.0), Vec3::new(-sin, cos, 0.0), Vec3::Z);
+            let scale = Mat3::from_diagonal(scale.extend(1.0));
+            transform = translation * rotation * scale;
+            if let Some(s) = t.get("texCoord").and_then(|v| v.as_u64()) {
+                set = s as u32;
+            }
+            if !transform.is_finite() {
+                transform = Mat3::IDENTITY;
+            }
+        }
+        Self { set, transform }
+    }
 }
 
 impl Loader<'_> {
@@ -313,23 +367,39 @@ impl Loader<'_> {
                 if node.skin().is_some() {
                     self.info.ignore("skins (meshes drawn in their bind pose)");
                 }
+                // Default morph weights: the node's, else the mesh's (the rest pose).
+                let weights: Vec<f32> = node
+                    .weights()
+                    .or(mesh.weights())
+                    .map(<[f32]>::to_vec)
+                    .unwrap_or_default();
+                let instances = self.instances(&node, world)?;
                 for primitive in mesh.primitives() {
-                    let key = (mesh.index(), primitive.index());
+                    let key = (
+                        mesh.index(),
+                        primitive.index(),
+                        weights.iter().map(|w| w.to_bits()).collect::<Vec<u32>>(),
+                    );
                     let mesh_index = match self.primitive_meshes.get(&key) {
                         Some(&m) => m,
                         None => {
-                            let m = self.primitive(&mesh, &primitive)?;
+                            let m = self.primitive(&mesh, &primitive, &weights)?;
                             self.primitive_meshes.insert(key, m);
                             m
                         }
                     };
                     if let Some(mesh_index) = mesh_index {
-                        self.scene.draws.push(Draw {
-                            mesh: mesh_index,
-                            model: world,
-                            node_name: node.name().unwrap_or_default().to_string(),
-                            node_index: index,
-                        });
+                        self.budget
+                            .charge(instances.len() as u64, 128, "the draws of a node")
+                            .map_err(|e| self.invalid(e))?;
+                        for &model in &instances {
+                            self.scene.draws.push(Draw {
+                                mesh: mesh_index,
+                                model,
+                                node_name: node.name().unwrap_or_default().to_string(),
+                                node_index: index,
+                            });
+                        }
                     }
                 }
             }
@@ -357,6 +427,78 @@ impl Loader<'_> {
             scene: self.scene,
             info: self.info,
         })
+    }
+
+    /// The model matrices a node's mesh is drawn with: its world matrix, or one per instance of
+    /// `EXT_mesh_gpu_instancing` (world × the instance's TRS).
+    fn instances(&mut self, node: &gltf::Node, world: Mat4) -> Result<Vec<Mat4>, LoadError> {
+        let Some(ext) = node.extension_value("EXT_mesh_gpu_instancing") else {
+            return Ok(vec![world]);
+        };
+        let what = format!("node {} (EXT_mesh_gpu_instancing)", node.index());
+        let attributes = ext.get("attributes").and_then(|a| a.as_object());
+        let data = BufferData {
+            buffers: self.buffers,
+            decoded_views: self.decoded_views,
+        };
+        let mut read = |name: &str, components: usize| -> Result<Option<Vec<f32>>, LoadError> {
+            let Some(index) = attributes
+                .and_then(|a| a.get(name))
+                .and_then(|v| v.as_u64())
+            else {
+                return Ok(None);
+            };
+            let accessor = self
+                .document
+                .accessors()
+                .nth(index as usize)
+                .ok_or_else(|| {
+                    LoadError::invalid(self.path, format!("{what}: no accessor {index}"))
+                })?;
+            if accessor.dimensions().multiplicity() != components {
+                return Err(LoadError::invalid(
+                    self.path,
+                    format!("{what}: {name} accessor {index} has the wrong type"),
+                ));
+            }
+            let label = format!("{what}: {name} accessor {index}");
+            read_f32(&data, &accessor, &mut self.budget, &label)
+                .map(Some)
+                .map_err(|e| LoadError::invalid(self.path, e))
+        };
+        let translation = read("TRANSLATION", 3)?;
+        let rotation = read("ROTATION", 4)?;
+        let scale = read("SCALE", 3)?;
+        let counts = [
+            translation.as_ref().map(|t| t.len() / 3),
+            rotation.as_ref().map(|r| r.len() / 4),
+            scale.as_ref().map(|s| s.len() / 3),
+        ];
+        let mut known = counts.iter().flatten();
+        let Some(&count) = known.next() else {
+            return Ok(vec![world]);
+        };
+        if known.any(|&c| c != count) {
+            return Err(self.invalid(format!(
+                "{what}: the instance attributes have different counts"
+            )));
+        }
+        let mut models =
+            crate::budget::vec_with_capacity(count, &what).map_err(|e| self.invalid(e))?;
+        for i in 0..count {
+            let t = translation
+                .as_ref()
+                .map_or(Vec3::ZERO, |t| Vec3::from_slice(&t[3 * i..]));
+            let r = rotation.as_ref().map_or(Quat::IDENTITY, |r| {
+                let q = Vec4::from_slice(&r[4 * i..]);
+                q.try_normalize().map_or(Quat::IDENTITY, Quat::from_vec4)
+            });
+            let s = scale
+                .as_ref()
+                .map_or(Vec3::ONE, |s| Vec3::from_slice(&s[3 * i..]));
+            models.push(world * Mat4::from_scale_rotation_translation(s, r, t));
+        }
+        Ok(models)
     }
 
     /// Reads `resolution`, `clear_color` and `ambient` from the scene's extras.
@@ -452,12 +594,44 @@ impl Loader<'_> {
         }
     }
 
+    /// Converts a material; also records which texture coordinates its textures read
+    /// (`self.material_uv`), which the loader bakes into the meshes that use it.
     fn material(&mut self, material: &gltf::Material) -> Result<Material, LoadError> {
+        let name = named(material.name(), "material", material.index().unwrap_or(0));
         let pbr = material.pbr_metallic_roughness();
-        let base_color_texture = match pbr.base_color_texture() {
-            Some(info) => self.texture_binding(&info)?,
-            None => None,
+        let (base_color_texture, base_uv) = match pbr.base_color_texture() {
+            Some(info) => (self.texture_binding(&info)?, Some(UvMap::of(&info))),
+            None => (None, None),
         };
+        let strength = material
+            .extension_value("KHR_materials_emissive_strength")
+            .and_then(|v| v.get("emissiveStrength"))
+            .and_then(serde_json::Value::as_f64)
+            .filter(|s| s.is_finite() && *s >= 0.0)
+            .unwrap_or(1.0) as f32;
+        let mut emissive = Vec3::from(material.emissive_factor()) * strength;
+        if !emissive.is_finite() {
+            emissive = Vec3::ZERO;
+        }
+        let (mut emissive_texture, emissive_uv) = match material.emissive_texture() {
+            Some(info) => (self.texture_binding(&info)?, Some(UvMap::of(&info))),
+            None => (None, None),
+        };
+        let mut uv = base_color_texture.and(base_uv);
+        if emissive_texture.is_some() {
+            match uv {
+                None => uv = emissive_uv,
+                Some(base) if Some(base) != emissive_uv => {
+                    self.info.warn(format!(
+                        "material '{name}': the emissive texture reads other texture coordinates than the base colour texture; its emission is left out"
+                    ));
+                    emissive_texture = None;
+                    emissive = Vec3::ZERO;
+                }
+                Some(_) => {}
+            }
+        }
+        self.material_uv.push(uv);
         let alpha_mode = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => AlphaMode::Mask {
@@ -472,6 +646,8 @@ impl Loader<'_> {
             double_sided: material.double_sided(),
             alpha_mode,
             unlit: material.unlit(),
+            emissive,
+            emissive_texture,
         })
     }
 
@@ -480,14 +656,6 @@ impl Loader<'_> {
         info: &gltf::texture::Info,
     ) -> Result<Option<TextureBinding>, LoadError> {
         let texture = info.texture();
-        if info.tex_coord() != 0 {
-            self.info.warn(format!(
-                "texture {} uses TEXCOORD_{}; only TEXCOORD_0 is supported, so it is left out",
-                texture.index(),
-                info.tex_coord()
-            ));
-            return Ok(None);
-        }
         let Some(image_index) = self
             .patched
             .texture_images
@@ -631,6 +799,7 @@ impl Loader<'_> {
         &mut self,
         mesh: &gltf::Mesh,
         primitive: &gltf::Primitive,
+        weights: &[f32],
     ) -> Result<Option<usize>, LoadError> {
         let mesh_name = named(mesh.name(), "mesh", mesh.index());
         let what = format!("mesh '{mesh_name}' primitive {}", primitive.index());
@@ -644,9 +813,12 @@ impl Loader<'_> {
             ));
             return Ok(None);
         }
-        if primitive.morph_targets().len() > 0 {
-            self.info.ignore("morph targets");
-        }
+        let material = match primitive.material().index() {
+            Some(m) => m,
+            None => self.default_material(),
+        };
+        let uv = self.material_uv.get(material).copied().flatten();
+        let uv_set = uv.map_or(0, |u| u.set);
 
         let check = |semantic: &str,
                      accessor: &gltf::Accessor,
@@ -704,9 +876,10 @@ impl Loader<'_> {
         if let Some(a) = &normal_accessor {
             check("NORMAL", a, &normal_types, &[Dimensions::Vec3])?;
         }
-        let texcoord_accessor = primitive.get(&Semantic::TexCoords(0));
+        let texcoord_name = format!("TEXCOORD_{uv_set}");
+        let texcoord_accessor = primitive.get(&Semantic::TexCoords(uv_set));
         if let Some(a) = &texcoord_accessor {
-            check("TEXCOORD_0", a, &any_int, &[Dimensions::Vec2])?;
+            check(&texcoord_name, a, &any_int, &[Dimensions::Vec2])?;
         }
         let color_accessor = primitive.get(&Semantic::Colors(0));
         if let Some(a) = &color_accessor {
@@ -754,16 +927,43 @@ impl Loader<'_> {
             None => None,
         };
         let texcoords = match &texcoord_accessor {
-            Some(a) if a.count() != n => return Err(count_error("TEXCOORD_0", a.count())),
-            Some(a) => Some(
-                read("TEXCOORD_0", a)
-                    .map_err(|e| LoadError::invalid(self.path, e))?
-                    .chunks_exact(2)
-                    .map(Vec2::from_slice)
-                    .collect::<Vec<_>>(),
-            ),
+            Some(a) if a.count() != n => return Err(count_error(&texcoord_name, a.count())),
+            Some(a) => {
+                let transform = uv.map_or(Mat3::IDENTITY, |u| u.transform);
+                Some(
+                    read(&texcoord_name, a)
+                        .map_err(|e| LoadError::invalid(self.path, e))?
+                        .chunks_exact(2)
+                        .map(|t| transform.transform_point2(Vec2::from_slice(t)))
+                        .collect::<Vec<_>>(),
+                )
+            }
             None => None,
         };
+        let (mut positions, mut normals) = (positions, normals);
+        for (target, &weight) in primitive.morph_targets().zip(weights) {
+            if weight == 0.0 || !weight.is_finite() {
+                continue;
+            }
+            let mut apply = |accessor: Option<gltf::Accessor>,
+                             values: &mut [Vec3],
+                             semantic: &str|
+             -> Result<(), LoadError> {
+                let Some(a) = accessor else { return Ok(()) };
+                if a.count() != n || a.dimensions() != Dimensions::Vec3 {
+                    return Err(count_error(semantic, a.count()));
+                }
+                let deltas = read(semantic, &a).map_err(|e| LoadError::invalid(self.path, e))?;
+                for (v, d) in values.iter_mut().zip(deltas.chunks_exact(3)) {
+                    *v += weight * Vec3::from_slice(d);
+                }
+                Ok(())
+            };
+            apply(target.positions(), &mut positions, "morph target POSITION")?;
+            if let Some(normals) = normals.as_mut() {
+                apply(target.normals(), normals, "morph target NORMAL")?;
+            }
+        }
         let colors = match &color_accessor {
             Some(a) if a.count() != n => return Err(count_error("COLOR_0", a.count())),
             Some(a) => {
@@ -817,10 +1017,6 @@ impl Loader<'_> {
                 "{what}: index {index} at position {position} is out of range for {n} vertices"
             )));
         }
-        let material = match primitive.material().index() {
-            Some(m) => m,
-            None => self.default_material(),
-        };
         let mut converted = Mesh {
             name: mesh_name,
             positions,

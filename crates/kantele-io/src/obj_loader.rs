@@ -170,6 +170,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
             double_sided: false,
             alpha_mode,
             unlit: false,
+            ..Material::default()
         });
     }
     let mut default_material = None;

@@ -79,6 +79,8 @@ pub struct MaterialShader<'a> {
     pass: Pass,
     /// `(instance id, draw id)` for the id pass.
     ids: (f32, f32),
+    /// Emissive texture (see [`MaterialShader::with_emissive_texture`]).
+    emissive_texture: Option<(&'a Texture, Sampler)>,
 }
 
 impl<'a> MaterialShader<'a> {
@@ -101,7 +103,15 @@ impl<'a> MaterialShader<'a> {
             texture,
             pass,
             ids: (ids.0 as f32, ids.1 as f32),
+            emissive_texture: None,
         }
+    }
+
+    /// The same shader reading the material's emissive texture (emission: `material.emissive`
+    /// × this texture at the base colour's texture coordinates, added after lighting).
+    pub fn with_emissive_texture(mut self, texture: Option<(&'a Texture, Sampler)>) -> Self {
+        self.emissive_texture = texture;
+        self
     }
 
     /// The fixed-function state the material asks for: culling unless double-sided, and for
@@ -197,11 +207,32 @@ impl Shader for MaterialShader<'_> {
         let l = self.lighting;
         let n_dot_l = self.normal(fragment).dot(l.to_light).max(0.0);
         let light = Vec3::splat(l.ambient) + (1.0 - l.ambient) * n_dot_l * l.light_color;
-        Some((base.truncate() * light).extend(alpha))
+        // --- emissive (loaders work): added after lighting ---
+        let emissive = self.emissive(fragment);
+        Some((base.truncate() * light + emissive).extend(alpha))
     }
 }
 
 impl MaterialShader<'_> {
+    /// Emitted colour: `material.emissive` × the emissive texture, if any (loaders work).
+    #[inline]
+    fn emissive(&self, fragment: &Fragment<'_>) -> Vec3 {
+        let mut emissive = self.material.emissive;
+        if let Some((texture, sampler)) = self.emissive_texture {
+            let v = fragment.varyings();
+            let (du_dx, du_dy) = fragment.derivatives(3);
+            let (dv_dx, dv_dy) = fragment.derivatives(4);
+            let sample = texture.sample_grad(
+                &sampler,
+                Vec2::new(v[3], v[4]),
+                Vec2::new(du_dx, dv_dx),
+                Vec2::new(du_dy, dv_dy),
+            );
+            emissive *= sample.truncate();
+        }
+        emissive
+    }
+
     /// The value of the normals or ids pass.
     #[inline]
     fn auxiliary(&self, fragment: &Fragment<'_>) -> Vec4 {

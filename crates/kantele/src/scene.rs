@@ -118,6 +118,12 @@ pub struct Material {
     pub alpha_mode: AlphaMode,
     /// `KHR_materials_unlit`: colour = base colour.
     pub unlit: bool,
+    /// Linear emitted colour (`emissiveFactor` × `KHR_materials_emissive_strength`), added after
+    /// lighting (lit materials only).
+    pub emissive: Vec3,
+    /// sRGB emissive texture, multiplied into `emissive`; read with the base colour's
+    /// texture coordinates.
+    pub emissive_texture: Option<TextureBinding>,
 }
 
 impl Default for Material {
@@ -129,6 +135,8 @@ impl Default for Material {
             double_sided: false,
             alpha_mode: AlphaMode::Opaque,
             unlit: false,
+            emissive: Vec3::ZERO,
+            emissive_texture: None,
         }
     }
 }
@@ -407,7 +415,10 @@ impl Scene {
             }
         }
         for (i, material) in self.materials.iter().enumerate() {
-            if let Some(binding) = material.base_color_texture {
+            for binding in [material.base_color_texture, material.emissive_texture]
+                .into_iter()
+                .flatten()
+            {
                 if binding.texture >= self.textures.len() {
                     return Err(RenderError::InvalidScene(format!(
                         "material {i} refers to texture {} of {}",

@@ -107,6 +107,11 @@ impl Backend for CpuBackend {
                     view.pass,
                     (draw.node_index as u32 + 1, i as u32 + 1),
                 )
+                .with_emissive_texture(
+                    material
+                        .emissive_texture
+                        .map(|b| (&*scene.textures[b.texture], b.sampler)),
+                )
             })
             .collect();
         let clear = match view.pass {
