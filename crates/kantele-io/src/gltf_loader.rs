@@ -36,7 +36,6 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
 /// requiring one is an error (using one without requiring it is refused where it is used).
 const UNREADABLE_EXTENSIONS: &[&str] = &[
     "KHR_draco_mesh_compression",
-    "EXT_meshopt_compression",
     "KHR_texture_basisu",
     "EXT_texture_avif",
     "MSFT_texture_dds",
