@@ -11,7 +11,7 @@ pub(crate) const MAX_EAR_CLIP_CORNERS: usize = 4096;
 /// clipping (the caller falls back to a fan).
 pub(crate) fn triangulate(corners: &[Vec3]) -> Option<Vec<[usize; 3]>> {
     let n = corners.len();
-    if n < 3 || n > MAX_EAR_CLIP_CORNERS || corners.iter().any(|c| !c.is_finite()) {
+    if !(3..=MAX_EAR_CLIP_CORNERS).contains(&n) || corners.iter().any(|c| !c.is_finite()) {
         return None;
     }
     if n == 3 {

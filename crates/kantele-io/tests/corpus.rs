@@ -418,8 +418,7 @@ fn realworld_files_render_with_their_properties() {
 
     // Draco used without being required: one line naming the extension.
     let err = load_scene(&dir.join("BoxDraco.gltf"))
-        .err()
-        .expect("Draco is refused")
+        .expect_err("Draco is refused")
         .to_string();
     assert!(
         err.contains("KHR_draco_mesh_compression") && err.lines().count() == 1,

@@ -100,10 +100,7 @@ fn sparse_accessor_bomb_is_refused_before_allocating() {
     let dir = temp_dir("sparse-bomb");
     let path = dir.join("bomb.glb");
     sparse_bomb(1 << 31).write_glb(&path);
-    let err = load_scene(&path)
-        .err()
-        .expect("must be refused")
-        .to_string();
+    let err = load_scene(&path).expect_err("must be refused").to_string();
     assert!(err.contains("memory budget"), "{err}");
     assert!(err.contains("bomb.glb"), "{err}");
     // Under a 1 GiB address-space cap the child must report the error, not abort.
@@ -132,8 +129,7 @@ fn huge_declared_image_is_refused_from_its_header() {
         ..LoadOptions::default()
     };
     let err = load_scene_with(&path, &small)
-        .err()
-        .expect("must be refused")
+        .expect_err("must be refused")
         .to_string();
     assert!(
         err.contains("16000x16000") && err.contains("memory budget"),
@@ -188,7 +184,7 @@ fn reads_are_confined_to_the_scene_folder() {
     // The buffer moved one folder up: refused unless that folder is allowed.
     let path = write_quad_referring_to(&scene_dir, "../quad.bin");
     std::fs::rename(scene_dir.join("quad.bin"), base.join("quad.bin")).unwrap();
-    let err = load_scene(&path).err().expect("outside").to_string();
+    let err = load_scene(&path).expect_err("outside").to_string();
     assert!(err.contains("outside the scene's folder"), "{err}");
     let allowed = LoadOptions {
         allow_read: vec![base.clone()],
@@ -198,19 +194,18 @@ fn reads_are_confined_to_the_scene_folder() {
     // A symbolic link inside the folder that points outside is resolved and refused.
     std::os::unix::fs::symlink(base.join("quad.bin"), scene_dir.join("link.bin")).unwrap();
     let path = write_quad_referring_to(&scene_dir, "link.bin");
-    let err = load_scene(&path).err().expect("symlink out").to_string();
+    let err = load_scene(&path).expect_err("symlink out").to_string();
     assert!(err.contains("outside the scene's folder"), "{err}");
     // Devices and absolute file URIs.
     let path = write_quad_referring_to(&scene_dir, "file:///dev/zero");
-    let err = load_scene(&path).err().expect("device").to_string();
+    let err = load_scene(&path).expect_err("device").to_string();
     assert!(err.contains("outside"), "{err}");
     let everything = LoadOptions {
         allow_read: vec![PathBuf::from("/dev")],
         ..LoadOptions::default()
     };
     let err = load_scene_with(&path, &everything)
-        .err()
-        .expect("device")
+        .expect_err("device")
         .to_string();
     assert!(err.contains("not a regular file"), "{err}");
     // A FIFO inside the folder is never opened (opening it would hang).
@@ -218,13 +213,13 @@ fn reads_are_confined_to_the_scene_folder() {
     let made = Command::new("mkfifo").arg(&fifo).status();
     if made.is_ok_and(|s| s.success()) {
         let path = write_quad_referring_to(&scene_dir, "fifo.bin");
-        let err = load_scene(&path).err().expect("fifo").to_string();
+        let err = load_scene(&path).expect_err("fifo").to_string();
         assert!(err.contains("not a regular file"), "{err}");
     }
     // A folder.
     std::fs::create_dir_all(scene_dir.join("folder.bin")).unwrap();
     let path = write_quad_referring_to(&scene_dir, "folder.bin");
-    let err = load_scene(&path).err().expect("folder").to_string();
+    let err = load_scene(&path).expect_err("folder").to_string();
     assert!(err.contains("not a regular file"), "{err}");
 }
 

@@ -197,8 +197,7 @@ fn huge_obj_polygon_is_refused_by_the_budget() {
         ..kantele_io::LoadOptions::default()
     };
     let err = kantele_io::load_scene_with(&path, &options)
-        .err()
-        .expect("refused")
+        .expect_err("refused")
         .to_string();
     assert!(
         err.contains("memory budget") && err.contains("huge.obj"),

@@ -79,8 +79,7 @@ fn draco_is_refused_by_name_even_when_not_required() {
     g.json["meshes"][0]["primitives"][0]["extensions"] =
         json!({"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}});
     let err = load_scene(&write(&g, "draco"))
-        .err()
-        .expect("refused")
+        .expect_err("refused")
         .to_string();
     assert!(err.contains("KHR_draco_mesh_compression"), "{err}");
     assert_eq!(err.lines().count(), 1);
