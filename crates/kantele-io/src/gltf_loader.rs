@@ -269,12 +269,13 @@ impl UvMap {
             let offset = pair("offset", Vec2::ZERO);
             let scale = pair("scale", Vec2::ONE);
             let rotation = t.get("rotation").and_then(|v| v.as_f64()).unwrap_or(0.0) as f32;
-            // uv' = T × R × S × uv, the matrices exactly as the extension's GLSL writes them
-            // (column-major: R's columns are (cos, sin) and (−sin, cos)).
+            // uv' = T × R × S × uv. R's columns are (cos, −sin) and (sin, cos): the direction
+            // in which the sample models (TextureTransformTest, TextureTransformMultiTest) and
+            // the common viewers rotate; checked by the corpus test.
             let (sin, cos) = rotation.sin_cos();
             let translation = Mat3::from_cols(Vec3::X, Vec3::Y, offset.extend(1.0));
             let rotation =
-                Mat3::from_cols(Vec3::new(cos, sin, 0.0), Vec3::new(-sin, cos, 0.0), Vec3::Z);
+                Mat3::from_cols(Vec3::new(cos, -sin, 0.0), Vec3::new(sin, cos, 0.0), Vec3::Z);
             let scale = Mat3::from_diagonal(scale.extend(1.0));
             transform = translation * rotation * scale;
             if let Some(s) = t.get("texCoord").and_then(|v| v.as_u64()) {

@@ -416,6 +416,35 @@ fn realworld_files_render_with_their_properties() {
         }
     }
 
+    // TextureTransformMultiTest: the transformed TEXCOORD_0 and TEXCOORD_1 of the test cells
+    // land inside the atlas region of the untransformed sample cell (the same checkmark; a
+    // wrong rotation direction lands elsewhere and draws a crossed shape).
+    let loaded = load(&dir.join(files[2]));
+    let uv_box = |name: &str| {
+        let mesh = loaded
+            .scene
+            .meshes
+            .iter()
+            .find(|m| m.name == name)
+            .expect(name);
+        let uv = mesh.texcoords.as_ref().expect("texcoords");
+        uv.iter()
+            .fold((glam::Vec2::MAX, glam::Vec2::MIN), |(lo, hi), t| {
+                (lo.min(*t), hi.max(*t))
+            })
+    };
+    let sample = uv_box("BaseColorSample");
+    for cell in ["BaseColorUV0", "BaseColorUV1"] {
+        let (lo, hi) = uv_box(cell);
+        let eps = 1e-3;
+        assert!(
+            lo.cmpge(sample.0 - eps).all() && hi.cmple(sample.1 + eps).all(),
+            "{cell}: uv box {lo}..{hi} outside the sample's {}..{}",
+            sample.0,
+            sample.1
+        );
+    }
+
     // Draco used without being required: one line naming the extension.
     let err = load_scene(&dir.join("BoxDraco.gltf"))
         .expect_err("Draco is refused")
