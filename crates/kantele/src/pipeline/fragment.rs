@@ -45,7 +45,7 @@ impl RasterCounters {
 pub(super) fn raster_tiles(
     framebuffer: &mut Framebuffer,
     bins: &TileBins,
-    geometry: &GeometryOutput,
+    geometry: &GeometryOutput<'_>,
     draws: &[Box<dyn DrawJob + '_>],
     strategy: Strategy,
     isa: Isa,
@@ -60,7 +60,7 @@ pub(super) fn raster_tiles(
             let mut counters = RasterCounters::default();
             let mut coverage = BlockCoverage::default();
             for t in bins.tile(tile_index) {
-                let tri = &geometry.triangles[t as usize];
+                let tri = geometry.triangle(t);
                 let draw = &draws[tri.draw as usize];
                 // Early rejection: behind everything already in this tile.
                 if draw.rejects_by_depth_bound() {
@@ -75,7 +75,7 @@ pub(super) fn raster_tiles(
                 if coverage.is_empty() {
                     continue;
                 }
-                let attrs = geometry.attrs_of(t as usize, draws);
+                let attrs = geometry.attrs(t);
                 let c = draw.raster(tri, attrs, &coverage, tile, isa);
                 counters = RasterCounters::sum(counters, c);
             }
