@@ -18,8 +18,16 @@
 //!
 //! Read `ARCHITECTURE.md` (section "CUDA backend") for how a frame runs on the GPU.
 
+#![warn(missing_docs)]
+#![warn(unsafe_op_in_unsafe_fn)]
+
+mod backend;
 pub mod defines;
 pub mod kernels;
 pub mod layout;
 pub mod nvrtc;
+pub mod plan;
 pub mod records;
+
+pub use backend::{driver_present, CudaBackend};
+pub use plan::CudaStrategy;

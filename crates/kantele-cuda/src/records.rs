@@ -204,6 +204,15 @@ pub struct SceneView {
 unsafe impl cudarc::driver::DeviceRepr for FrameUniforms {}
 // SAFETY: as above; the fields are device addresses, passed by value.
 unsafe impl cudarc::driver::DeviceRepr for SceneView {}
+// SAFETY: plain `#[repr(C)]` data, copied to the device as is and read there with the layout of
+// common.cuh (sizes `static_assert`ed, offsets compared at start-up by the layout probe).
+unsafe impl cudarc::driver::DeviceRepr for DrawRecord {}
+// SAFETY: as for `DrawRecord`.
+unsafe impl cudarc::driver::DeviceRepr for TextureRecord {}
+// SAFETY: as for `DrawRecord`.
+unsafe impl cudarc::driver::DeviceRepr for LevelRecord {}
+// SAFETY: as for `DrawRecord`.
+unsafe impl cudarc::driver::DeviceRepr for SlotInfo {}
 
 /// The scene flattened for upload: every array the kernels read, built once at `load`.
 #[derive(Clone, Debug, Default)]
