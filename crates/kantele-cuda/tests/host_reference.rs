@@ -1,6 +1,7 @@
-//! The kernels' device functions (clip-space classification, clipping, fixed-point setup,
-//! barycentrics, depth) compiled as host C++ and compared bit for bit with the Rust core on
-//! thousands of random triangles. Every `_rn` CUDA intrinsic the kernels use is a correctly
+//! The kernels' device functions (the matrix products and vertex transform, clip-space
+//! classification, clipping, fixed-point setup, barycentrics, depth, texture sampling with every
+//! wrap mode and filter) compiled as host C++ and compared bit for bit with the Rust core on
+//! thousands of random inputs. Every `_rn` CUDA intrinsic the kernels use is a correctly
 //! rounded IEEE operation, as x86-64's SSE arithmetic is, so agreement here means the GPU
 //! computes the CPU's coverage and depth (what is left for the GPU machine: the compiler and the
 //! hardware keeping that promise — `gpu-check.sh`).
@@ -12,11 +13,13 @@ use std::io::Write;
 use std::path::PathBuf;
 use std::process::{Command, Stdio};
 
-use glam::Vec4;
+use glam::{Mat4, Quat, Vec2, Vec3, Vec4};
 use kantele::geometry::clip::{classify, ClipPolygon, ClipTest, ClipVertex, GuardBand};
 use kantele::setup::{setup_triangle, CullMode, FrontFace, SetupReject, TriangleSetup, Viewport};
+use kantele::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 use kantele::MAX_VARYINGS;
 use kantele_cuda::defines::{define_options, MATERIAL_VARYINGS};
+use kantele_cuda::records::{filter_code, min_filter_code, wrap_code};
 
 const NV: usize = MATERIAL_VARYINGS;
 
@@ -148,7 +151,7 @@ fn hex(v: f32) -> String {
 fn input_line(c: &Case) -> String {
     let g = GuardBand::new(c.width, c.height);
     let mut s = format!(
-        "{} {} {} {} {} {} {} {}",
+        "T {} {} {} {} {} {} {} {}",
         c.width,
         c.height,
         c.cull_back as u32,
@@ -339,4 +342,147 @@ fn kernel_setup_and_clipping_match_the_core_bit_for_bit() {
         }
         assert_eq!(device.lines().count(), expected.lines().count());
     }
+}
+
+/// Runs the harness on `input` and returns its output.
+fn run_harness(harness: &PathBuf, input: String) -> String {
+    let mut child = Command::new(harness)
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .spawn()
+        .expect("run the harness");
+    let mut stdin = child.stdin.take().expect("stdin");
+    let writer = std::thread::spawn(move || stdin.write_all(input.as_bytes()));
+    let output = child.wait_with_output().expect("harness output");
+    writer.join().expect("writer").expect("write input");
+    assert!(output.status.success(), "the harness failed");
+    String::from_utf8(output.stdout).expect("utf-8")
+}
+
+#[test]
+fn kernel_matrices_and_vertex_transform_match_glam() {
+    let Some(harness) = build_harness() else {
+        return;
+    };
+    let mut rng = Rng(0x1234_5678_9abc_def1);
+    let mut input = String::new();
+    let mut expected = String::new();
+    for _ in 0..2000 {
+        let mut r = || rng.range(-3.0, 3.0);
+        let view = Mat4::look_at_rh(
+            Vec3::new(r(), r(), r() + 8.0),
+            Vec3::new(r(), r(), r()),
+            Vec3::Y,
+        );
+        let projection =
+            Mat4::perspective_rh_gl(0.2 + r().abs() * 0.4, 1.0 + r().abs(), 0.01, 100.0);
+        let vp = projection * view;
+        let model = Mat4::from_scale_rotation_translation(
+            Vec3::new(r(), r(), r()),
+            Quat::from_euler(glam::EulerRot::XYZ, r(), r(), r()),
+            Vec3::new(r(), r(), r()),
+        );
+        let p = Vec3::new(r(), r(), r());
+        input.push('M');
+        for v in vp
+            .to_cols_array()
+            .iter()
+            .chain(&model.to_cols_array())
+            .chain(&p.to_array())
+        {
+            input.push(' ');
+            input.push_str(&hex(*v));
+        }
+        input.push('\n');
+        // As MaterialShader::new and ::vertex compute them.
+        let mvp = vp * model;
+        let clip = mvp * p.extend(1.0);
+        expected.push('M');
+        for v in mvp.to_cols_array().iter().chain(&clip.to_array()) {
+            expected.push(' ');
+            expected.push_str(&hex(*v));
+        }
+        expected.push('\n');
+    }
+    let device = run_harness(&harness, input);
+    for (i, (d, e)) in device.lines().zip(expected.lines()).enumerate() {
+        assert_eq!(d, e, "case {i}");
+    }
+    assert_eq!(device.lines().count(), 2000);
+}
+
+#[test]
+fn kernel_texture_sampling_matches_the_core_bit_for_bit() {
+    let Some(harness) = build_harness() else {
+        return;
+    };
+    let mut rng = Rng(0x0ddb_a11c_afe5_eed5);
+    let sizes = [(1, 1), (5, 3), (8, 8), (16, 4), (3, 7)];
+    let wraps = [Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat];
+    let mins = [
+        MinFilter::Nearest,
+        MinFilter::Linear,
+        MinFilter::NearestMipmapNearest,
+        MinFilter::LinearMipmapNearest,
+        MinFilter::NearestMipmapLinear,
+        MinFilter::LinearMipmapLinear,
+    ];
+    let mut input = String::new();
+    let mut expected = String::new();
+    let cases = 3000;
+    for _ in 0..cases {
+        let (w, h) = sizes[rng.below(sizes.len() as u64) as usize];
+        let texels = (0..w * h)
+            .map(|_| Vec4::new(rng.unit(), rng.unit(), rng.unit(), rng.unit()))
+            .collect();
+        let texture = Texture::from_rgba_f32(w, h, texels).expect("texture");
+        let sampler = Sampler {
+            wrap_s: wraps[rng.below(3) as usize],
+            wrap_t: wraps[rng.below(3) as usize],
+            mag_filter: if rng.below(2) == 0 {
+                Filter::Nearest
+            } else {
+                Filter::Linear
+            },
+            min_filter: mins[rng.below(6) as usize],
+        };
+        let uv = Vec2::new(rng.range(-3.0, 3.0), rng.range(-3.0, 3.0));
+        let lod = match rng.below(4) {
+            0 => -rng.unit(),
+            1 => rng.range(0.0, 1.0),
+            _ => rng.range(0.0, 5.0),
+        };
+        input.push_str(&format!("X {}", texture.levels().len()));
+        for level in texture.levels() {
+            input.push_str(&format!(" {} {}", level.width, level.height));
+            for t in &level.texels {
+                for v in t.to_array() {
+                    input.push(' ');
+                    input.push_str(&hex(v));
+                }
+            }
+        }
+        input.push_str(&format!(
+            " {} {} {} {} {} {} {}\n",
+            wrap_code(sampler.wrap_s),
+            wrap_code(sampler.wrap_t),
+            filter_code(sampler.mag_filter),
+            min_filter_code(sampler.min_filter),
+            hex(uv.x),
+            hex(uv.y),
+            hex(lod)
+        ));
+        let c = texture.sample_lod(&sampler, uv, lod);
+        expected.push('X');
+        for v in c.to_array() {
+            expected.push(' ');
+            expected.push_str(&hex(v));
+        }
+        expected.push('\n');
+    }
+    let device = run_harness(&harness, input);
+    for (i, (d, e)) in device.lines().zip(expected.lines()).enumerate() {
+        assert_eq!(d, e, "case {i}");
+    }
+    assert_eq!(device.lines().count(), cases);
 }

@@ -6,6 +6,7 @@
 #include "../../kernels/common.cuh"
 
 #include <cstdio>
+#include <cstdlib>
 
 static float from_bits(unsigned int b) { return __int_as_float(b); }
 static unsigned int bits(float f) {
@@ -45,9 +46,72 @@ static void print_setup(int code, const TriangleSetup& t) {
     }
 }
 
+static float read_float() {
+    unsigned int b = 0;
+    if (std::scanf("%x", &b) != 1) std::exit(1);
+    return from_bits(b);
+}
+
+// "M": view_projection (16), model (16), position (3) → MVP (16) and the clip position (4), as
+// kantele_draw_matrices and kantele_vertex compute them.
+static void matrices() {
+    float vp[16], model[16], mvp[16], pos[3];
+    for (float& v : vp) v = read_float();
+    for (float& v : model) v = read_float();
+    for (float& v : pos) v = read_float();
+    for (int c = 0; c < 4; ++c) {
+        V4 col = mat4_mul_v4(vp, v4_load(model + 4 * c));
+        mvp[4 * c] = col.x;
+        mvp[4 * c + 1] = col.y;
+        mvp[4 * c + 2] = col.z;
+        mvp[4 * c + 3] = col.w;
+    }
+    V4 p = mat4_mul_v4(mvp, {pos[0], pos[1], pos[2], 1.0f});
+    std::printf("M");
+    for (float v : mvp) std::printf(" %08x", bits(v));
+    std::printf(" %08x %08x %08x %08x\n", bits(p.x), bits(p.y), bits(p.z), bits(p.w));
+}
+
+// "X": a texture's levels (count, then width height texels... each), the sampler codes
+// (wrap_s wrap_t mag min), uv and λ → the sample (`Texture::sample_lod`).
+static void texture() {
+    unsigned int count;
+    if (std::scanf("%u", &count) != 1 || count == 0 || count > 16) std::exit(1);
+    LevelRecord levels[16];
+    static float4 texels[1 << 16];
+    u64 at = 0;
+    for (unsigned int i = 0; i < count; ++i) {
+        if (std::scanf("%u %u", &levels[i].width, &levels[i].height) != 2) std::exit(1);
+        levels[i].offset = at;
+        u64 n = (u64)levels[i].width * levels[i].height;
+        if (at + n > (1u << 16)) std::exit(1);
+        for (u64 k = 0; k < n; ++k) {
+            float r = read_float(), g = read_float(), b = read_float(), a = read_float();
+            texels[at + k] = make_float4(r, g, b, a);
+        }
+        at += n;
+    }
+    TextureRecord tex = {0, count, levels[0].width, levels[0].height};
+    DrawRecord d = {};
+    if (std::scanf("%u %u %u %u", &d.wrap_s, &d.wrap_t, &d.mag_filter, &d.min_filter) != 4) std::exit(1);
+    float u = read_float(), v = read_float(), lod = read_float();
+    V4 c = sample_lod(texels, tex, levels, d, u, v, lod);
+    std::printf("X %08x %08x %08x %08x\n", bits(c.x), bits(c.y), bits(c.z), bits(c.w));
+}
+
 int main() {
     unsigned int w, h, cull_back, front_cw;
-    while (std::scanf("%u %u %u %u", &w, &h, &cull_back, &front_cw) == 4) {
+    char kind[2];
+    while (std::scanf("%1s", kind) == 1) {
+        if (kind[0] == 'M') {
+            matrices();
+            continue;
+        }
+        if (kind[0] == 'X') {
+            texture();
+            continue;
+        }
+        if (std::scanf("%u %u %u %u", &w, &h, &cull_back, &front_cw) != 4) return 1;
         FrameUniforms f = {};
         unsigned int kx, ky, hw, hh;
         if (std::scanf("%x %x %x %x", &kx, &ky, &hw, &hh) != 4) return 1;
