@@ -55,6 +55,7 @@ struct Row {
     backend: String,
     renderer: String,
     threads: usize,
+    isa: String,
     result: Result<Timing, String>,
     ratio: Option<f64>,
 }
@@ -79,7 +80,7 @@ fn time_frames(
 
 fn print_table(rows: &[Row], ratios: bool) {
     let mut header = format!(
-        "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:>10} {:>10} {:>10}",
+        "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:<6} {:>10} {:>10} {:>10}",
         "scene",
         "size",
         "triangles",
@@ -87,6 +88,7 @@ fn print_table(rows: &[Row], ratios: bool) {
         "backend",
         "renderer",
         "threads",
+        "isa",
         "median ms",
         "min ms",
         "max ms"
@@ -98,8 +100,8 @@ fn print_table(rows: &[Row], ratios: bool) {
     for r in rows {
         let size = format!("{}x{}", r.width, r.height);
         let mut line = format!(
-            "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7}",
-            r.scene, size, r.triangles, r.draws, r.backend, r.renderer, r.threads
+            "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:<6}",
+            r.scene, size, r.triangles, r.draws, r.backend, r.renderer, r.threads, r.isa
         );
         match &r.result {
             Ok(t) => {
@@ -126,7 +128,10 @@ fn print_side_by_side(rows: &[Row], backends: &[String]) {
     println!();
     for name in backends {
         if let Some(r) = rows.iter().find(|r| &r.backend == name && r.result.is_ok()) {
-            println!("{name}: {} ({} threads)", r.renderer, r.threads);
+            println!(
+                "{name}: {} ({} threads, isa {})",
+                r.renderer, r.threads, r.isa
+            );
         }
     }
     let mut header = format!(
@@ -161,6 +166,28 @@ fn print_side_by_side(rows: &[Row], backends: &[String]) {
         }
         println!("{line}");
     }
+    // Geometric mean of each ratio column, over the scenes where both backends rendered.
+    let mut line = format!("{:<24} {:>11} {:>10} {:>6}", "geometric mean", "", "", "");
+    line.push_str(&" ".repeat(11 * backends.len()));
+    for column in 1..backends.len() {
+        let ratios: Vec<f64> = rows
+            .chunks(backends.len())
+            .filter_map(|scene_rows| scene_rows.get(column).and_then(|r| r.ratio))
+            .collect();
+        match geometric_mean(&ratios) {
+            Some(g) => line.push_str(&format!(" {g:>10.2}")),
+            None => line.push_str(&format!(" {:>10}", "-")),
+        }
+    }
+    println!("{line}");
+}
+
+/// The geometric mean of positive values (`None` for none).
+fn geometric_mean(values: &[f64]) -> Option<f64> {
+    if values.is_empty() || values.iter().any(|v| v.is_nan() || *v <= 0.0) {
+        return None;
+    }
+    Some((values.iter().map(|v| v.ln()).sum::<f64>() / values.len() as f64).exp())
 }
 
 /// Runs `kantele bench`.
@@ -195,15 +222,15 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let mut reference: Option<f64> = None;
         let mut any_ok = false;
         for (i, (name, backend)) in backends.iter_mut().enumerate() {
-            let (renderer, threads, result) = match backend {
+            let (renderer, threads, isa, result) = match backend {
                 Ok(b) => {
                     let result = b
                         .load(scene.clone())
                         .map_err(|e| e.to_string())
                         .and_then(|()| time_frames(b.as_mut(), &view, args.warmup, args.frames));
-                    (b.renderer(), b.threads(), result)
+                    (b.renderer(), b.threads(), b.isa(), result)
                 }
-                Err(e) => ("-".to_string(), 0, Err(e.clone())),
+                Err(e) => ("-".to_string(), 0, "-".to_string(), Err(e.clone())),
             };
             if let Err(e) = &result {
                 if !several {
@@ -229,6 +256,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 backend: name.clone(),
                 renderer,
                 threads,
+                isa,
                 result,
                 ratio,
             };
@@ -243,7 +271,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                         "scene": row.scene, "source": loaded.info.source,
                         "width": row.width, "height": row.height,
                         "triangles": row.triangles, "draws": row.draws,
-                        "backend": row.backend, "renderer": row.renderer, "threads": row.threads,
+                        "backend": row.backend, "renderer": row.renderer, "threads": row.threads, "isa": row.isa,
                         "frames": args.frames, "warmup": args.warmup,
                         "median_ms": median, "min_ms": min, "max_ms": max,
                         "ratio": row.ratio, "available": error.is_none(), "error": error,
@@ -280,5 +308,13 @@ mod tests {
         assert_eq!((t.median, t.min, t.max), (2.0, 1.0, 3.0));
         let t = summarize(&[4.0, 1.0, 2.0, 3.0]).unwrap();
         assert_eq!((t.median, t.min, t.max), (2.5, 1.0, 4.0));
+    }
+
+    #[test]
+    fn geometric_mean_of_ratios() {
+        assert_eq!(geometric_mean(&[]), None);
+        assert_eq!(geometric_mean(&[2.0, 0.0]), None);
+        let g = geometric_mean(&[2.0, 8.0]).unwrap();
+        assert!((g - 4.0).abs() < 1e-12, "{g}");
     }
 }

@@ -19,7 +19,6 @@
 
 mod backends;
 mod bench;
-mod camera_math;
 mod cli;
 mod compare;
 mod compare_cmd;

@@ -7,20 +7,26 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::{anyhow, bail, Result};
-use glam::Vec3;
 use indicatif::{ProgressBar, ProgressStyle};
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
-use kantele::scene::{Camera, Scene};
-use serde_json::{json, Value};
+use kantele::scene::Scene;
+use kantele_io::pose::sidecar::{
+    DrawId, InstanceId, SidecarCamera, SidecarDepth, SidecarIds, SidecarNormals, ID_CHANNELS,
+    MATRIX_LAYOUT,
+};
+use kantele_io::pose::{rows, Bounds, CameraPose, Sidecar, UpAxis};
+use serde_json::json;
 
 use crate::backends::make_backend;
-use crate::camera_math::{eye_depth, intrinsics, opencv_from_gl, rows};
 use crate::cli::{DepthKind, RenderArgs};
 use crate::output::{self, digits_for, expand_template, extension, has_placeholder, TemplateVars};
 use crate::scenes::{self, Input, Warnings};
 
 /// Elevation of the orbit cameras above the bounding sphere's equator.
 pub const ORBIT_ELEVATION_DEG: f32 = 20.0;
+
+/// Vertical field of view of the orbit cameras, degrees.
+pub const ORBIT_YFOV_DEG: f32 = 45.0;
 
 /// The files one image writes.
 #[derive(Clone, Debug)]
@@ -121,26 +127,32 @@ fn plan_outputs(args: &RenderArgs, inputs: &[Input], views: usize) -> Result<Vec
     Ok(plan)
 }
 
-/// The cameras of one scene: its own, or `n` orbit views.
-fn cameras(scene: &Scene, orbit: Option<u32>, aspect: f32, label: &str) -> Result<Vec<Camera>> {
+/// The cameras of one scene at `width × height`: its own, or `n` orbit views.
+fn cameras(
+    scene: &Scene,
+    orbit: Option<u32>,
+    width: u32,
+    height: u32,
+    label: &str,
+) -> Result<Vec<CameraPose>> {
     let Some(n) = orbit else {
-        return Ok(vec![scene.camera]);
+        let pose = CameraPose::from_scene_camera(&scene.camera, width, height)
+            .map_err(|e| anyhow!("{label}: camera: {e}"))?;
+        return Ok(vec![pose]);
     };
-    let (center, radius) = scene
-        .bounding_sphere()
+    let bounds = Bounds::of_scene(scene)
         .ok_or_else(|| anyhow!("{label}: the scene draws nothing, so there is nothing to orbit"))?;
-    let elevation = ORBIT_ELEVATION_DEG.to_radians();
-    Ok((0..n)
-        .map(|k| {
-            let theta = std::f32::consts::TAU * k as f32 / n as f32;
-            let dir = Vec3::new(
-                theta.sin() * elevation.cos(),
-                elevation.sin(),
-                theta.cos() * elevation.cos(),
-            );
-            Camera::framing(center, radius, dir, aspect)
-        })
-        .collect())
+    CameraPose::orbit(
+        &bounds,
+        n,
+        ORBIT_ELEVATION_DEG,
+        None,
+        UpAxis::Y,
+        ORBIT_YFOV_DEG.to_radians(),
+        width,
+        height,
+    )
+    .map_err(|e| anyhow!("{label}: {e}"))
 }
 
 /// Highest ids of a scene's id pass: (instance, primitive, draw).
@@ -219,30 +231,28 @@ fn render_pass(
 fn write_color(path: &Path, frame: &FrameImage) -> Result<()> {
     if extension(path) == "exr" {
         let data: Vec<f32> = frame.color.iter().flatten().copied().collect();
-        output::write_exr_rgba32f(path, frame.width, frame.height, &data)
+        output::write_exr_rgba32f(path, frame.width, frame.height, &data)?;
     } else {
-        output::write_png_rgba8(path, frame.width, frame.height, &frame.to_rgba8(true))
+        output::write_png_rgba8(path, frame.width, frame.height, &frame.to_rgba8(true))?;
     }
+    Ok(())
 }
 
-fn depth_values(frame: &FrameImage, kind: DepthKind, view: &FrameView) -> Vec<f32> {
+fn depth_values(frame: &FrameImage, kind: DepthKind, pose: &CameraPose) -> Vec<f32> {
     match kind {
         DepthKind::Window => frame.depth.clone(),
-        DepthKind::Eye => frame
-            .depth
-            .iter()
-            .map(|&d| eye_depth(d, &view.projection))
-            .collect(),
+        DepthKind::Eye => pose.planar_depth(&frame.depth),
     }
 }
 
 fn write_depth(path: &Path, frame: &FrameImage, values: &[f32]) -> Result<()> {
     if extension(path) == "exr" {
         let rgb: Vec<f32> = values.iter().flat_map(|&v| [v, v, v]).collect();
-        output::write_exr_rgb32f(path, frame.width, frame.height, &rgb)
+        output::write_exr_rgb32f(path, frame.width, frame.height, &rgb)?;
     } else {
-        output::write_pfm(path, frame.width, frame.height, values)
+        output::write_pfm(path, frame.width, frame.height, values)?;
     }
+    Ok(())
 }
 
 fn write_normals(path: &Path, frame: &FrameImage) -> Result<()> {
@@ -258,7 +268,7 @@ fn write_normals(path: &Path, frame: &FrameImage) -> Result<()> {
                 }
             })
             .collect();
-        output::write_exr_rgb32f(path, frame.width, frame.height, &rgb)
+        output::write_exr_rgb32f(path, frame.width, frame.height, &rgb)?;
     } else {
         let enc = |v: f32| ((v * 0.5 + 0.5).clamp(0.0, 1.0) * 255.0).round() as u8;
         let rgba: Vec<u8> = (0..frame.color.len())
@@ -271,8 +281,9 @@ fn write_normals(path: &Path, frame: &FrameImage) -> Result<()> {
                 }
             })
             .collect();
-        output::write_png_rgba8(path, frame.width, frame.height, &rgba)
+        output::write_png_rgba8(path, frame.width, frame.height, &rgba)?;
     }
+    Ok(())
 }
 
 fn write_ids(path: &Path, frame: &FrameImage) -> Result<()> {
@@ -295,7 +306,7 @@ fn write_ids(path: &Path, frame: &FrameImage) -> Result<()> {
         for &v in &rgb {
             id(v)?;
         }
-        output::write_exr_rgb32f(path, frame.width, frame.height, &rgb)
+        output::write_exr_rgb32f(path, frame.width, frame.height, &rgb)?;
     } else {
         let mut rgb = Vec::with_capacity(frame.color.len() * 3);
         for c in &frame.color {
@@ -310,8 +321,9 @@ fn write_ids(path: &Path, frame: &FrameImage) -> Result<()> {
                 rgb.push(v);
             }
         }
-        output::write_png_rgb16(path, frame.width, frame.height, &rgb)
+        output::write_png_rgb16(path, frame.width, frame.height, &rgb)?;
     }
+    Ok(())
 }
 
 #[allow(clippy::too_many_arguments)]
@@ -320,26 +332,16 @@ fn sidecar(
     input: &Input,
     loaded_source: &str,
     scene: &Scene,
-    camera: &Camera,
-    view: &FrameView,
+    pose: &CameraPose,
     out: &Outputs,
     backend: &dyn Backend,
     ms: f64,
-) -> Value {
-    let k = intrinsics(&view.projection, view.width, view.height);
+) -> Sidecar {
+    let path = |p: &PathBuf| p.display().to_string();
+    let depth_file = out.depth.as_ref().map(path);
     let depth = match args.depth_kind {
-        DepthKind::Eye => json!({
-            "file": out.depth.as_ref().map(|p| p.display().to_string()),
-            "kind": "eye",
-            "description": "distance along the camera's view axis (-z in OpenGL eye space, +z in OpenCV camera space), scene units, 32-bit float",
-            "background": "inf",
-        }),
-        DepthKind::Window => json!({
-            "file": out.depth.as_ref().map(|p| p.display().to_string()),
-            "kind": "window",
-            "description": "window depth (ndc_z + 1) / 2 in [0, 1] under the projection below, 32-bit float",
-            "background": 1.0,
-        }),
+        DepthKind::Eye => SidecarDepth::eye(depth_file),
+        DepthKind::Window => SidecarDepth::window(depth_file),
     };
     let mut instances = std::collections::BTreeMap::new();
     for d in &scene.draws {
@@ -347,64 +349,61 @@ fn sidecar(
             .entry(d.node_index + 1)
             .or_insert_with(|| d.node_name.clone());
     }
-    let instance_ids: Vec<Value> = instances
-        .iter()
-        .map(|(id, name)| json!({ "id": id, "node_index": id - 1, "node_name": name }))
+    let instance_ids = instances
+        .into_iter()
+        .map(|(id, node_name)| InstanceId {
+            id,
+            node_index: id - 1,
+            node_name,
+        })
         .collect();
-    let draw_ids: Vec<Value> = scene
+    let draw_ids = scene
         .draws
         .iter()
         .enumerate()
-        .map(|(i, d)| {
-            json!({
-                "id": i + 1,
-                "mesh_index": d.mesh,
-                "mesh_name": scene.meshes.get(d.mesh).map(|m| m.name.as_str()).unwrap_or(""),
-                "node_index": d.node_index,
-                "node_name": d.node_name,
-            })
+        .map(|(i, d)| DrawId {
+            id: i + 1,
+            mesh_index: d.mesh,
+            mesh_name: scene
+                .meshes
+                .get(d.mesh)
+                .map(|m| m.name.clone())
+                .unwrap_or_default(),
+            node_index: d.node_index,
+            node_name: d.node_name.clone(),
         })
         .collect();
-    json!({
-        "scene": input.stem(),
-        "source": loaded_source,
-        "output": out.color.display().to_string(),
-        "width": view.width,
-        "height": view.height,
-        "backend": backend.name(),
-        "renderer": backend.renderer(),
-        "threads": backend.threads(),
-        "render_ms": ms,
-        "camera": {
-            "fx": k.fx, "fy": k.fy, "cx": k.cx, "cy": k.cy,
-            "pixel_centers": "integer coordinates (OpenCV): the top-left pixel's centre is (0, 0)",
-            "width": view.width,
-            "height": view.height,
-            "yfov": camera.yfov,
-            "aspect_ratio": camera.aspect_ratio.unwrap_or(view.width as f32 / view.height as f32),
-            "znear": camera.znear,
-            "zfar": camera.zfar,
-            "projection_gl": rows(&view.projection),
-        },
-        "world_to_camera_gl": rows(&view.view),
-        "world_to_camera_opencv": rows(&opencv_from_gl(&view.view)),
-        "matrix_layout": "row-major: matrix[row][column]; points are columns (p_cam = M * p_world)",
-        "depth": depth,
-        "normals": out.normals.as_ref().map(|p| json!({
-            "file": p.display().to_string(),
-            "encoding": if extension(p) == "exr" {
+    Sidecar {
+        scene: input.stem(),
+        source: loaded_source.to_string(),
+        output: path(&out.color),
+        width: pose.width,
+        height: pose.height,
+        backend: backend.name().to_string(),
+        renderer: backend.renderer(),
+        threads: backend.threads(),
+        render_ms: ms,
+        camera: SidecarCamera::of_pose(pose),
+        world_to_camera_gl: rows(&pose.view()),
+        world_to_camera_opencv: rows(&pose.world_to_camera_opencv()),
+        matrix_layout: MATRIX_LAYOUT.into(),
+        depth,
+        normals: out.normals.as_ref().map(|p| SidecarNormals {
+            file: path(p),
+            encoding: if extension(p) == "exr" {
                 "world-space unit normal as float RGB, background 0"
             } else {
                 "world-space unit normal n as 8-bit linear (n * 0.5 + 0.5) * 255 in RGB, alpha 255; background 0 0 0 0"
-            },
-        })),
-        "ids": {
-            "file": out.ids.as_ref().map(|p| p.display().to_string()),
-            "channels": "R = instance id (node_index + 1), G = primitive id (triangle index in its mesh + 1), B = draw id (draw index + 1); 0 = background",
-            "instance_ids": instance_ids,
-            "draw_ids": draw_ids,
+            }
+            .into(),
+        }),
+        ids: SidecarIds {
+            file: out.ids.as_ref().map(path),
+            channels: ID_CHANNELS.into(),
+            instance_ids,
+            draw_ids,
         },
-    })
+    }
 }
 
 /// Runs `kantele render`.
@@ -452,9 +451,9 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         backend
             .load(scene.clone())
             .map_err(|e| anyhow!("{label}: {e}"))?;
-        let cams = cameras(&scene, args.orbit, width as f32 / height as f32, &label)?;
-        for (camera, out) in cams.iter().zip(outs) {
-            let mut view = FrameView::with_camera(&scene, camera, width, height);
+        let cams = cameras(&scene, args.orbit, width, height, &label)?;
+        for (pose, out) in cams.iter().zip(outs) {
+            let mut view = pose.frame_view(&scene, Pass::Color);
             let (color, ms) = render_pass(backend.as_mut(), &view, &label)?;
             let mut rendered = Rendered {
                 color,
@@ -477,7 +476,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 write_depth(
                     p,
                     &rendered.color,
-                    &depth_values(&rendered.color, args.depth_kind, &view),
+                    &depth_values(&rendered.color, args.depth_kind, pose),
                 )?;
             }
             if let (Some(p), Some(f)) = (&out.normals, &rendered.normals) {
@@ -491,17 +490,15 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 input,
                 &source,
                 &scene,
-                camera,
-                &view,
+                pose,
                 out,
                 backend.as_ref(),
                 rendered.ms,
             );
             output::write_atomic(&out.sidecar, |w| {
                 serde_json::to_writer_pretty(&mut *w, &meta)?;
-                Ok(std::io::Write::write_all(w, b"\n")?)
-            })
-            .map_err(|e| anyhow!("{}: {e}", out.sidecar.display()))?;
+                std::io::Write::write_all(w, b"\n")
+            })?;
             if args.json {
                 let line = json!({
                     "scene": input.stem(),
@@ -522,6 +519,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use glam::Vec3;
 
     fn synthetic() -> FrameImage {
         // 3x2: background, then covered pixels with ids / normals / colours.
@@ -587,16 +585,15 @@ mod tests {
     #[test]
     fn depth_files() {
         let frame = synthetic();
-        let projection = kantele::camera::perspective(1.0, 1.5, 0.5, 10.0);
-        let view = FrameView {
-            width: 3,
-            height: 2,
-            view: glam::Mat4::IDENTITY,
-            projection,
-            to_light: Vec3::Z,
-            light_color: Vec3::ONE,
-            pass: Pass::Color,
-        };
+        let view = CameraPose::new(
+            3,
+            2,
+            kantele_io::pose::Projection::Perspective { yfov: 1.0 },
+            0.5,
+            Some(10.0),
+            glam::Mat4::IDENTITY,
+        )
+        .unwrap();
         let eye = depth_values(&frame, DepthKind::Eye, &view);
         assert!(eye[0].is_infinite());
         assert!(eye[1..]
@@ -604,7 +601,7 @@ mod tests {
             .all(|d| d.is_finite() && *d >= 0.5 && *d <= 10.0));
         let p = tmp("d.pfm");
         write_depth(&p, &frame, &eye).unwrap();
-        let (w, h, back) = output::decode_pfm(std::fs::File::open(&p).unwrap()).unwrap();
+        let (w, h, back) = kantele_io::output::decode_pfm(&std::fs::read(&p).unwrap()).unwrap();
         assert_eq!((w, h), (3, 2));
         assert_eq!(back, eye);
         std::fs::remove_file(&p).unwrap();
@@ -636,18 +633,15 @@ mod tests {
             node_name: "n".into(),
             node_index: 0,
         });
-        let cams = cameras(&scene, Some(4), 1.0, "x").unwrap();
+        let cams = cameras(&scene, Some(4), 64, 64, "x").unwrap();
         assert_eq!(cams.len(), 4);
-        let eyes: Vec<Vec3> = cams
-            .iter()
-            .map(|c| c.world_from_eye().transform_point3(Vec3::ZERO))
-            .collect();
+        let eyes: Vec<Vec3> = cams.iter().map(|c| c.eye()).collect();
         let d0 = eyes[0].length();
         for e in &eyes {
             assert!((e.length() - d0).abs() < 1e-3);
             assert!(e.y > 0.0);
         }
         assert!(eyes[0].z > 0.0 && eyes[1].x > 0.0 && eyes[2].z < 0.0 && eyes[3].x < 0.0);
-        assert!(cameras(&Scene::default(), Some(2), 1.0, "x").is_err());
+        assert!(cameras(&Scene::default(), Some(2), 64, 64, "x").is_err());
     }
 }

@@ -121,6 +121,7 @@ impl App {
         let mut b = CpuBackend::new(CpuOptions {
             threads: self.args.cpu.threads,
             strategy,
+            ..CpuOptions::default()
         })
         .map_err(|e| anyhow!("cpu backend: {e}"))?;
         b.load(self.scene.clone()).map_err(|e| anyhow!("{e}"))?;

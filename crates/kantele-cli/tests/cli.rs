@@ -92,13 +92,7 @@ fn assert_clean_failure(o: &Output, needle: &str, dir: &TempDir, keep: &[&str]) 
 }
 
 fn shared_scenes() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("skipping: {} is absent", dir.display());
-        None
-    }
+    kantele_testkit::shared_dir("scenes")
 }
 
 fn distinct_colors(img: &image::RgbaImage) -> usize {
@@ -543,9 +537,9 @@ fn gl_available() -> bool {
         "0",
     ]);
     if !o.status.success() {
-        eprintln!(
-            "skipping: the gl backend is unavailable here: {}",
-            stderr(&o).trim()
+        kantele_testkit::skip(
+            "gl",
+            format!("the gl backend is unavailable here: {}", stderr(&o).trim()),
         );
     }
     o.status.success()
@@ -642,7 +636,10 @@ fn on_path(program: &str) -> bool {
 #[test]
 fn viewer_under_xvfb() {
     if !on_path("xvfb-run") {
-        eprintln!("skipping: xvfb-run is not on PATH (apt-get install xvfb xauth)");
+        kantele_testkit::skip(
+            "display",
+            "xvfb-run is not on PATH (apt-get install xvfb xauth)",
+        );
         return;
     }
     let dir = TempDir::new("view");

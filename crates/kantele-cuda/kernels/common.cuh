@@ -52,15 +52,23 @@ struct TriangleSetup {
     unsigned char swapped;
 };
 
+// `kantele_cuda::records::SamplerCodes`: a texture binding's sampler.
+struct SamplerCodes {
+    u32 wrap_s, wrap_t, mag_filter, min_filter;
+};
+
 // `kantele_cuda::records::DrawRecord`: one scene draw, uploaded at load.
 struct DrawRecord {
     float model[16];          // column-major
     float normal_matrix[9];   // column-major
     float base_color_factor[4];
+    float emissive[3];        // linear emitted colour, added after lighting
     float alpha_cutoff;
     u32 flags;                // KANTELE_DRAW_*
-    u32 texture;              // index into the texture table when KANTELE_DRAW_TEXTURED
-    u32 wrap_s, wrap_t, mag_filter, min_filter;
+    u32 texture;              // base colour texture when KANTELE_DRAW_TEXTURED
+    SamplerCodes sampler;
+    u32 emissive_texture;     // when KANTELE_DRAW_EMISSIVE_TEXTURED
+    SamplerCodes emissive_sampler;
     u32 node_id;              // node index + 1
     u32 draw_id;              // draw index + 1
     u32 vertex_base;          // first vertex of the mesh in the scene's vertex array
@@ -68,7 +76,13 @@ struct DrawRecord {
     u32 index_base;           // first index of the mesh in the scene's index array
     u32 triangle_count;
     u32 shaded_base;          // first slot of this draw in the frame's shaded vertices
-    u32 triangle_base;        // first slot of this draw in the frame's triangle slots
+};
+
+// `kantele_cuda::records::DrawIssue`: the frame's draws in issue order (`Scene::draw_order`:
+// BLEND draws last, back to front), each with its first triangle slot.
+struct DrawIssue {
+    u32 draw;
+    u32 slot_base;
 };
 
 // `kantele::material::StandardVertex`.
@@ -127,6 +141,7 @@ static_assert(sizeof(TextureRecord) == KANTELE_TEXTURE_RECORD_SIZE, "TextureReco
 static_assert(sizeof(LevelRecord) == KANTELE_LEVEL_RECORD_SIZE, "LevelRecord size");
 static_assert(sizeof(FrameUniforms) == KANTELE_FRAME_UNIFORMS_SIZE, "FrameUniforms size");
 static_assert(sizeof(SlotInfo) == KANTELE_SLOT_INFO_SIZE, "SlotInfo size");
+static_assert(sizeof(DrawIssue) == KANTELE_DRAW_ISSUE_SIZE, "DrawIssue size");
 
 // Frame status words (u64), read by the host once at the end of a frame.
 enum StatusWord {
@@ -495,7 +510,7 @@ __device__ __forceinline__ V4 fetch(const float4* texels, const LevelRecord& l, 
     return {t.x, t.y, t.z, t.w};
 }
 
-__device__ V4 sample_level(const float4* texels, const LevelRecord& l, const DrawRecord& d,
+__device__ V4 sample_level(const float4* texels, const LevelRecord& l, const SamplerCodes& d,
                            u32 filter, float uvx, float uvy) {
     int w = (int)l.width;
     int h = (int)l.height;
@@ -540,7 +555,7 @@ __device__ float texture_lod(const TextureRecord& tex, float dudx, float dvdx, f
 
 // `Texture::sample_lod`.
 __device__ V4 sample_lod(const float4* texels, const TextureRecord& tex, const LevelRecord* levels,
-                         const DrawRecord& d, float uvx, float uvy, float lod) {
+                         const SamplerCodes& d, float uvx, float uvy, float lod) {
     if (!(isfinite(uvx) && isfinite(uvy))) return {0.0f, 0.0f, 0.0f, 0.0f};
     const LevelRecord* chain = levels + tex.first_level;
     if (lod <= 0.0f || isnan(lod)) return sample_level(texels, chain[0], d, d.mag_filter, uvx, uvy);
@@ -633,6 +648,18 @@ __device__ __forceinline__ V4 auxiliary(const FrameUniforms& f, const DrawRecord
     return {(float)d.node_id, add((float)t.primitive_id, 1.0f), (float)d.draw_id, 1.0f};
 }
 
+// `Texture::sample_grad` at the fragment's texture coordinates (varyings 3, 4) with their
+// analytic derivatives.
+__device__ V4 sample_grad(const SceneView& s, const TriangleSetup& t, const float* attrs,
+                          const FragmentInput& in, u32 texture, const SamplerCodes& sampler) {
+    float dudx, dudy, dvdx, dvdy;
+    derivatives(t, attrs, in, 3, dudx, dudy);
+    derivatives(t, attrs, in, 4, dvdx, dvdy);
+    const TextureRecord tex = s.textures[texture];
+    float lod = texture_lod(tex, dudx, dvdx, dudy, dvdy);
+    return sample_lod(s.texels, tex, s.levels, sampler, in.varyings[3], in.varyings[4], lod);
+}
+
 // `MaterialShader::fragment`: false = discard.
 __device__ bool shade_fragment(const FrameUniforms& f, const SceneView& s, const TriangleSetup& t,
                                const float* attrs, const FragmentInput& in, V4& out) {
@@ -645,12 +672,7 @@ __device__ bool shade_fragment(const FrameUniforms& f, const SceneView& s, const
     V4 color = {in.varyings[5], in.varyings[6], in.varyings[7], in.varyings[8]};
     V4 base = v4_mul(v4_load(d.base_color_factor), color);
     if (d.flags & KANTELE_DRAW_TEXTURED) {
-        float dudx, dudy, dvdx, dvdy;
-        derivatives(t, attrs, in, 3, dudx, dudy);
-        derivatives(t, attrs, in, 4, dvdx, dvdy);
-        const TextureRecord tex = s.textures[d.texture];
-        float lod = texture_lod(tex, dudx, dvdx, dudy, dvdy);
-        base = v4_mul(base, sample_lod(s.texels, tex, s.levels, d, in.varyings[3], in.varyings[4], lod));
+        base = v4_mul(base, sample_grad(s, t, attrs, in, d.texture, d.sampler));
     }
     float alpha = 1.0f;
     if (d.flags & KANTELE_DRAW_ALPHA_MASK) {
@@ -671,7 +693,14 @@ __device__ bool shade_fragment(const FrameUniforms& f, const SceneView& s, const
     float k = mul(sub(1.0f, f.ambient), n_dot_l);
     V3 light = {add(f.ambient, mul(k, f.light_color[0])), add(f.ambient, mul(k, f.light_color[1])),
                 add(f.ambient, mul(k, f.light_color[2]))};
-    out = {mul(base.x, light.x), mul(base.y, light.y), mul(base.z, light.z), alpha};
+    // Emission (`MaterialShader::emissive`): factor × emissive texture, added after lighting.
+    V3 e = {d.emissive[0], d.emissive[1], d.emissive[2]};
+    if (d.flags & KANTELE_DRAW_EMISSIVE_TEXTURED) {
+        V4 sample = sample_grad(s, t, attrs, in, d.emissive_texture, d.emissive_sampler);
+        e = {mul(e.x, sample.x), mul(e.y, sample.y), mul(e.z, sample.z)};
+    }
+    out = {add(mul(base.x, light.x), e.x), add(mul(base.y, light.y), e.y),
+           add(mul(base.z, light.z), e.z), alpha};
     return true;
 }
 

@@ -23,13 +23,16 @@ extern "C" __global__ void kantele_layout_probe(const TriangleSetup* t, const Dr
     out[i++] = OFFSET(t, swapped);
     out[i++] = OFFSET(d, normal_matrix);
     out[i++] = OFFSET(d, base_color_factor);
+    out[i++] = OFFSET(d, emissive);
     out[i++] = OFFSET(d, alpha_cutoff);
     out[i++] = OFFSET(d, flags);
     out[i++] = OFFSET(d, texture);
+    out[i++] = OFFSET(d, sampler);
+    out[i++] = OFFSET(d, emissive_texture);
+    out[i++] = OFFSET(d, emissive_sampler);
     out[i++] = OFFSET(d, node_id);
     out[i++] = OFFSET(d, vertex_base);
     out[i++] = OFFSET(d, shaded_base);
-    out[i++] = OFFSET(d, triangle_base);
     out[i++] = OFFSET(f, to_light);
     out[i++] = OFFSET(f, ambient);
     out[i++] = OFFSET(f, guard_kx);

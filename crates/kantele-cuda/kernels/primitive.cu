@@ -1,4 +1,5 @@
-// Primitive stage: per triangle slot (submission order), assembly, the NaN check, trivial
+// Primitive stage: per triangle slot (submission order: the draws in issue order, each draw's
+// triangles in index order), assembly, the NaN check, trivial
 // reject, near-plane / guard-band clipping, culling and fixed-point setup (`Frame::end`'s
 // `run_geometry` → `DrawCall::assemble` / `emit`).
 //
@@ -11,13 +12,15 @@
 
 #define MAX_FAN (KANTELE_MAX_CLIPPED_VERTICES - 2)
 
-__device__ __forceinline__ u32 draw_of_slot(const DrawRecord* draws, u32 count, u32 s) {
+// The issued draw whose slots hold `s` (issue entries are sorted by `slot_base`; a binary search
+// for the last base ≤ s).
+__device__ __forceinline__ DrawIssue issue_of_slot(const DrawIssue* issue, u32 count, u32 s) {
     u32 lo = 0, hi = count;
     while (hi - lo > 1) {
         u32 mid = (lo + hi) / 2;
-        if (draws[mid].triangle_base <= s) lo = mid; else hi = mid;
+        if (issue[mid].slot_base <= s) lo = mid; else hi = mid;
     }
-    return lo;
+    return issue[lo];
 }
 
 // Block-wide counters, added to the frame status once per block.
@@ -37,7 +40,7 @@ __device__ __forceinline__ void write_setup(TriangleSetup* setups, float* attrs,
 }
 
 extern "C" __global__ void kantele_primitive(FrameUniforms f, const DrawRecord* draws,
-                                             const u32* indices, const float4* pos_clip,
+                                             const DrawIssue* issue, const u32* indices, const float4* pos_clip,
                                              const float* varyings, TriangleSetup* setups,
                                              float* setup_attrs, SlotInfo* slots, u64* status) {
     __shared__ PrimitiveCounters block;
@@ -47,9 +50,10 @@ extern "C" __global__ void kantele_primitive(FrameUniforms f, const DrawRecord* 
     PrimitiveCounters c = {0, 0, 0, 0, 0, 0, 0};
     if (s < f.slot_count) {
         SlotInfo info = {s, 0};
-        u32 d = draw_of_slot(draws, f.draw_count, s);
+        const DrawIssue is = issue_of_slot(issue, f.draw_count, s);
+        const u32 d = is.draw;
         const DrawRecord& draw = draws[d];
-        u32 t = s - draw.triangle_base;
+        const u32 t = s - is.slot_base;
         bool cull_back = !(draw.flags & KANTELE_DRAW_DOUBLE_SIDED);
         bool front_cw = (draw.flags & KANTELE_DRAW_FRONT_CW) != 0;
         c.in = 1;

@@ -30,7 +30,10 @@ use crate::plan::{
     baseline_grid, ocmt_batches, tiled_frame, Capacities, CudaStrategy, FrameShape, Kernel, Needs,
     Stage, Step, BASELINE_BLOCK, SCAN_THREADS,
 };
-use crate::records::{pass_code, view_projection, FrameUniforms, SceneArrays, SceneView, SlotInfo};
+use crate::records::{
+    draw_issue, pass_code, view_projection, DrawIssue, FrameUniforms, SceneArrays, SceneView,
+    SlotInfo,
+};
 
 const NAME: &str = "cuda";
 
@@ -83,6 +86,11 @@ impl Functions {
 
 /// The scene's data on the device, uploaded once at `load`.
 struct SceneBuffers {
+    scene: Arc<Scene>,
+    records: Vec<crate::records::DrawRecord>,
+    /// The draw order `issue` was last written for.
+    issued_order: Vec<usize>,
+    issue: CudaSlice<DrawIssue>,
     arrays_shape: (u32, u32, u32), // draws, shaded vertices, slots
     clear_color: [f32; 4],
     ambient: f32,
@@ -405,6 +413,7 @@ impl CudaBackend {
             shared_mem_bytes: 0,
         };
         let a = |b: &CudaSlice<_>| self.addr(b);
+        let issue = self.addr(&scene.issue);
         let (draws, vertices, indices) = (
             self.addr(&scene.draws),
             self.addr(&scene.vertices),
@@ -476,6 +485,7 @@ impl CudaBackend {
             Kernel::Primitive => {
                 args.arg(u)
                     .arg(&draws)
+                    .arg(&issue)
                     .arg(&indices)
                     .arg(&pos)
                     .arg(&vary)
@@ -754,7 +764,13 @@ impl Backend for CudaBackend {
             })
             .collect();
         let texels: Vec<f32> = arrays.texels.iter().flatten().copied().collect();
+        let order: Vec<usize> = (0..arrays.draws.len()).collect();
+        let issue = draw_issue(&arrays.draws, &order);
         let buffers = SceneBuffers {
+            scene: scene.clone(),
+            records: arrays.draws.clone(),
+            issued_order: order,
+            issue: self.upload(&issue, DrawIssue::default(), "draw order")?,
             arrays_shape: (
                 arrays.draws.len() as u32,
                 arrays.shaded_count,
@@ -785,9 +801,19 @@ impl Backend for CudaBackend {
                 height: view.height,
             });
         }
-        let Some(scene) = &self.scene else {
+        let Some(scene) = self.scene.as_mut() else {
             return Err(RenderError::InvalidScene("no scene loaded".into()));
         };
+        // The reference-scene rule: BLEND draws last, back to front for this camera. The order
+        // (and so the slots' submission order) is uploaded only when it changes.
+        let order = scene.scene.draw_order(&view.view);
+        if order != scene.issued_order && !order.is_empty() {
+            let issue = draw_issue(&scene.records, &order);
+            self.stream
+                .memcpy_htod(&issue, &mut scene.issue)
+                .map_err(|e| failed("uploading the draw order", e))?;
+            scene.issued_order = order;
+        }
         let (draws, shaded, slots) = scene.arrays_shape;
         let shape = FrameShape {
             width: view.width,
@@ -879,6 +905,7 @@ impl Backend for CudaBackend {
                 binning_time: ms(1, 2),
                 raster_time: ms(2, 3),
                 total_time: wall.elapsed(),
+                ..FrameStats::default()
             });
         }
         Err(failed(

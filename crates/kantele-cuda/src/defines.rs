@@ -10,9 +10,9 @@ use kantele::setup::TriangleSetup;
 use kantele::shade::texture::{Filter, MinFilter, Wrap};
 
 use crate::records::{
-    filter_code, min_filter_code, pass_code, wrap_code, DrawRecord, FrameUniforms, LevelRecord,
-    SlotInfo, TextureRecord, DRAW_ALPHA_BLEND, DRAW_ALPHA_MASK, DRAW_DOUBLE_SIDED, DRAW_FRONT_CW,
-    DRAW_TEXTURED, DRAW_UNLIT,
+    filter_code, min_filter_code, pass_code, wrap_code, DrawIssue, DrawRecord, FrameUniforms,
+    LevelRecord, SlotInfo, TextureRecord, DRAW_ALPHA_BLEND, DRAW_ALPHA_MASK, DRAW_DOUBLE_SIDED,
+    DRAW_EMISSIVE_TEXTURED, DRAW_FRONT_CW, DRAW_TEXTURED, DRAW_UNLIT,
 };
 use kantele::backend::Pass;
 
@@ -67,6 +67,7 @@ pub fn defines() -> Vec<(String, String)> {
         size_of::<FrameUniforms>() as i64,
     );
     int("KANTELE_SLOT_INFO_SIZE", size_of::<SlotInfo>() as i64);
+    int("KANTELE_DRAW_ISSUE_SIZE", size_of::<DrawIssue>() as i64);
 
     for (name, flag) in [
         ("KANTELE_DRAW_UNLIT", DRAW_UNLIT),
@@ -75,6 +76,7 @@ pub fn defines() -> Vec<(String, String)> {
         ("KANTELE_DRAW_ALPHA_BLEND", DRAW_ALPHA_BLEND),
         ("KANTELE_DRAW_TEXTURED", DRAW_TEXTURED),
         ("KANTELE_DRAW_FRONT_CW", DRAW_FRONT_CW),
+        ("KANTELE_DRAW_EMISSIVE_TEXTURED", DRAW_EMISSIVE_TEXTURED),
     ] {
         int(name, flag as i64);
     }

@@ -8,7 +8,7 @@ use kantele::camera::normal_matrix;
 use kantele::material::StandardVertex;
 use kantele::scene::{AlphaMode, Scene};
 use kantele::setup::FrontFace;
-use kantele::shade::texture::{Filter, MinFilter, Wrap};
+use kantele::shade::texture::{Filter, MinFilter, Sampler, Wrap};
 
 /// `DrawRecord::flags`: the material is unlit (`KHR_materials_unlit`).
 pub const DRAW_UNLIT: u32 = 1 << 0;
@@ -22,6 +22,8 @@ pub const DRAW_ALPHA_BLEND: u32 = 1 << 3;
 pub const DRAW_TEXTURED: u32 = 1 << 4;
 /// `DrawRecord::flags`: clockwise in NDC is front (the model matrix mirrors).
 pub const DRAW_FRONT_CW: u32 = 1 << 5;
+/// `DrawRecord::flags`: the emission is multiplied by an emissive texture.
+pub const DRAW_EMISSIVE_TEXTURED: u32 = 1 << 6;
 
 /// Kernel code of a [`Wrap`] mode.
 pub fn wrap_code(w: Wrap) -> u32 {
@@ -61,6 +63,32 @@ pub fn pass_code(p: Pass) -> u32 {
     }
 }
 
+/// A texture binding's sampler as kernel codes (`SamplerCodes` in `common.cuh`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct SamplerCodes {
+    /// Wrap mode in s ([`wrap_code`]).
+    pub wrap_s: u32,
+    /// Wrap mode in t ([`wrap_code`]).
+    pub wrap_t: u32,
+    /// Magnification filter ([`filter_code`]).
+    pub mag_filter: u32,
+    /// Minification filter ([`min_filter_code`]).
+    pub min_filter: u32,
+}
+
+impl SamplerCodes {
+    /// The codes of `sampler`.
+    pub fn new(sampler: &Sampler) -> Self {
+        Self {
+            wrap_s: wrap_code(sampler.wrap_s),
+            wrap_t: wrap_code(sampler.wrap_t),
+            mag_filter: filter_code(sampler.mag_filter),
+            min_filter: min_filter_code(sampler.min_filter),
+        }
+    }
+}
+
 /// One scene draw as the kernels see it (`DrawRecord` in `common.cuh`).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -71,20 +99,20 @@ pub struct DrawRecord {
     pub normal_matrix: [f32; 9],
     /// The material's base colour factor.
     pub base_color_factor: [f32; 4],
+    /// The material's linear emission, added after lighting.
+    pub emissive: [f32; 3],
     /// MASK cutoff.
     pub alpha_cutoff: f32,
     /// `DRAW_*` flags.
     pub flags: u32,
-    /// Texture index when `DRAW_TEXTURED`.
+    /// Base colour texture index when `DRAW_TEXTURED`.
     pub texture: u32,
-    /// Sampler wrap mode in s ([`wrap_code`]).
-    pub wrap_s: u32,
-    /// Sampler wrap mode in t ([`wrap_code`]).
-    pub wrap_t: u32,
-    /// Magnification filter ([`filter_code`]).
-    pub mag_filter: u32,
-    /// Minification filter ([`min_filter_code`]).
-    pub min_filter: u32,
+    /// Its sampler.
+    pub sampler: SamplerCodes,
+    /// Emissive texture index when `DRAW_EMISSIVE_TEXTURED`.
+    pub emissive_texture: u32,
+    /// Its sampler.
+    pub emissive_sampler: SamplerCodes,
     /// Node index + 1 (the ids pass' red channel).
     pub node_id: u32,
     /// Draw index + 1 (the ids pass' blue channel).
@@ -99,8 +127,34 @@ pub struct DrawRecord {
     pub triangle_count: u32,
     /// First slot of this draw among the frame's shaded vertices.
     pub shaded_base: u32,
-    /// First slot of this draw among the frame's triangles.
-    pub triangle_base: u32,
+}
+
+/// One draw of a frame in issue order (`DrawIssue` in `common.cuh`).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct DrawIssue {
+    /// Scene draw index.
+    pub draw: u32,
+    /// Its first triangle slot this frame.
+    pub slot_base: u32,
+}
+
+/// The frame's draws in `order` (`Scene::draw_order`) with their slot bases: each draw's
+/// triangles follow the previous draw's, so triangle slots are in submission order.
+pub fn draw_issue(draws: &[DrawRecord], order: &[usize]) -> Vec<DrawIssue> {
+    let mut base = 0u32;
+    order
+        .iter()
+        .filter_map(|&d| draws.get(d).map(|r| (d, r)))
+        .map(|(d, record)| {
+            let issue = DrawIssue {
+                draw: d as u32,
+                slot_base: base,
+            };
+            base = base.saturating_add(record.triangle_count);
+            issue
+        })
+        .collect()
 }
 
 /// A texture's place in the level table (`TextureRecord` in `common.cuh`).
@@ -213,6 +267,8 @@ unsafe impl cudarc::driver::DeviceRepr for TextureRecord {}
 unsafe impl cudarc::driver::DeviceRepr for LevelRecord {}
 // SAFETY: as for `DrawRecord`.
 unsafe impl cudarc::driver::DeviceRepr for SlotInfo {}
+// SAFETY: as for `DrawRecord`.
+unsafe impl cudarc::driver::DeviceRepr for DrawIssue {}
 
 /// The scene flattened for upload: every array the kernels read, built once at `load`.
 #[derive(Clone, Debug, Default)]
@@ -337,16 +393,18 @@ impl SceneArrays {
                 index_base,
                 triangle_count,
                 shaded_base: checked("shaded vertices per frame", shaded)?,
-                triangle_base: checked("triangles per frame", slots)?,
+                emissive: material.emissive.to_array(),
                 ..DrawRecord::default()
             };
             if let Some(binding) = material.base_color_texture {
                 record.flags |= DRAW_TEXTURED;
                 record.texture = binding.texture as u32;
-                record.wrap_s = wrap_code(binding.sampler.wrap_s);
-                record.wrap_t = wrap_code(binding.sampler.wrap_t);
-                record.mag_filter = filter_code(binding.sampler.mag_filter);
-                record.min_filter = min_filter_code(binding.sampler.min_filter);
+                record.sampler = SamplerCodes::new(&binding.sampler);
+            }
+            if let Some(binding) = material.emissive_texture {
+                record.flags |= DRAW_EMISSIVE_TEXTURED;
+                record.emissive_texture = binding.texture as u32;
+                record.emissive_sampler = SamplerCodes::new(&binding.sampler);
             }
             shaded += vertex_count as u64;
             slots += triangle_count as u64;
@@ -440,16 +498,23 @@ mod tests {
         let bases: Vec<(u32, u32, u32, u32)> = a
             .draws
             .iter()
-            .map(|d| (d.vertex_base, d.index_base, d.shaded_base, d.triangle_base))
+            .map(|d| (d.vertex_base, d.index_base, d.shaded_base, d.triangle_count))
             .collect();
-        assert_eq!(bases, vec![(3, 3, 0, 0), (0, 0, 4, 2), (3, 3, 7, 3)]);
+        assert_eq!(bases, vec![(3, 3, 0, 2), (0, 0, 4, 1), (3, 3, 7, 2)]);
+        // Issued in another order, slots follow that order.
+        let issue = draw_issue(&a.draws, &[2, 0, 1]);
+        let issue: Vec<(u32, u32)> = issue.iter().map(|i| (i.draw, i.slot_base)).collect();
+        assert_eq!(issue, vec![(2, 0), (0, 2), (1, 4)]);
         assert_eq!((a.shaded_count, a.slot_count), (11, 5));
         let d0 = a.draws[0];
         assert_eq!(
             d0.flags,
             DRAW_DOUBLE_SIDED | DRAW_ALPHA_MASK | DRAW_TEXTURED
         );
-        assert_eq!((d0.alpha_cutoff, d0.wrap_s, d0.min_filter), (0.25, 2, 4));
+        assert_eq!(
+            (d0.alpha_cutoff, d0.sampler.wrap_s, d0.sampler.min_filter),
+            (0.25, 2, 4)
+        );
         assert_eq!((d0.node_id, d0.draw_id), (5, 1));
         assert_eq!(a.draws[1].flags, DRAW_FRONT_CW, "the mirrored draw");
         assert_eq!((a.draws[2].node_id, a.draws[2].draw_id), (10, 3));

@@ -12,11 +12,6 @@ use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::scene::Scene;
 use kantele_gl::GlBackend;
 
-fn scenes_dir() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
-    dir.is_dir().then_some(dir)
-}
-
 fn render(backend: &mut dyn Backend, view: &FrameView) -> FrameImage {
     backend.render(view).expect("render");
     backend.read_frame().expect("read")
@@ -27,7 +22,7 @@ fn gl_or_skip() -> Option<GlBackend> {
     match GlBackend::new() {
         Ok(gl) => Some(gl),
         Err(e) => {
-            eprintln!("skipping: OpenGL unavailable: {e}");
+            kantele_testkit::skip("gl", format!("OpenGL unavailable: {e}"));
             None
         }
     }
@@ -109,8 +104,7 @@ const INTERIOR_BOUND: u8 = 3;
 
 #[test]
 fn every_reference_scene_agrees_with_opengl() {
-    let Some(dir) = scenes_dir() else {
-        eprintln!("skipping: ../shared/scenes not found");
+    let Some(dir) = kantele_testkit::shared_dir("scenes") else {
         return;
     };
     let Some(mut gl) = gl_or_skip() else {

@@ -18,7 +18,7 @@ fn backend() -> Option<GlBackend> {
     match GlBackend::new() {
         Ok(b) => Some(b),
         Err(e) => {
-            println!("skipping: {e}");
+            kantele_testkit::skip("gl", format!("OpenGL unavailable: {e}"));
             None
         }
     }

@@ -55,8 +55,8 @@ fn bench_traversal(c: &mut Criterion) {
         let mut bins = TileBins::default();
         bins.bin_triangles(&grid, &tris);
         let mut pixels = 0u64;
-        for (tile, bin) in bins.bins.iter().enumerate() {
-            for &t in bin {
+        for tile in 0..bins.tile_count() {
+            for t in bins.tile(tile) {
                 rasterize(
                     &tris[t as usize],
                     grid.tile_rect(tile),
@@ -74,9 +74,9 @@ fn bench_traversal(c: &mut Criterion) {
                 |b, &strategy| {
                     b.iter(|| {
                         let mut covered = 0u64;
-                        for (tile, bin) in bins.bins.iter().enumerate() {
+                        for tile in 0..bins.tile_count() {
                             let rect = grid.tile_rect(tile);
-                            for &t in bin {
+                            for t in bins.tile(tile) {
                                 rasterize(&tris[t as usize], rect, strategy, |x, _| {
                                     covered += x as u64 & 1 | 1
                                 });

@@ -60,12 +60,25 @@ impl FrameView {
         height: u32,
     ) -> Self {
         let aspect = width as f32 / height.max(1) as f32;
-        let (to_light, light_color) = scene.light.resolve(&camera.view);
+        Self::with_matrices(scene, camera.view, camera.projection(aspect), width, height)
+    }
+
+    /// The scene seen through explicit `view` (world → eye, OpenGL) and `projection` matrices
+    /// at `width × height`, lit by the scene's light (a headlight follows `view`). This is the
+    /// constructor camera modules such as `kantele_io::pose` build frames with.
+    pub fn with_matrices(
+        scene: &Scene,
+        view: Mat4,
+        projection: Mat4,
+        width: u32,
+        height: u32,
+    ) -> Self {
+        let (to_light, light_color) = scene.light.resolve(&view);
         Self {
             width,
             height,
-            view: camera.view,
-            projection: camera.projection(aspect),
+            view,
+            projection,
             to_light,
             light_color,
             pass: Pass::Color,
@@ -104,6 +117,11 @@ pub trait Backend {
     fn renderer(&self) -> String;
     /// Threads the backend renders with (1 for a GPU driver).
     fn threads(&self) -> usize;
+    /// The instruction set of the backend's per-pixel path (`"avx2"`, `"scalar"`, …), or `"-"`
+    /// where the question does not apply (a GPU driver).
+    fn isa(&self) -> String {
+        "-".to_string()
+    }
     /// Takes the scene and uploads what it needs. Not part of a frame.
     fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError>;
     /// Renders one complete frame of the loaded scene and waits until it is finished.

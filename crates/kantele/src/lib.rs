@@ -99,7 +99,7 @@
 //! `ARCHITECTURE.md` at the repository root describes the data flow, the fixed-point and
 //! interpolation rules, why pictures are deterministic, and how the crate is tested.
 #![warn(missing_docs)]
-#![forbid(unsafe_code)]
+#![deny(unsafe_code)]
 
 pub mod backend;
 pub mod camera;
@@ -119,11 +119,11 @@ pub mod rop;
 pub mod scene;
 pub mod setup;
 pub mod shade;
+#[allow(unsafe_code)]
+pub mod simd;
+pub mod state;
 pub mod stats;
 
 pub use error::RenderError;
 
-/// Largest render target side in pixels.
-pub const MAX_TARGET_SIZE: u32 = 16384;
-/// Most `f32` varyings a vertex can carry to the fragment stage.
-pub const MAX_VARYINGS: usize = 16;
+pub use state::{MAX_TARGET_SIZE, MAX_VARYINGS};

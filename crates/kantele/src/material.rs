@@ -10,11 +10,12 @@ use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 use crate::backend::Pass;
 use crate::camera::normal_matrix;
-use crate::pipeline::{Fragment, RenderState, Shader};
+use crate::pipeline::{Fragment, FragmentLanes, RenderState, ShadedLanes, Shader};
 use crate::rop::BlendMode;
 use crate::scene::{AlphaMode, Material, Mesh};
 use crate::setup::CullMode;
 use crate::shade::texture::{Sampler, Texture};
+use crate::simd::{F32x8, Lanes, Mask8};
 
 /// The vertex layout of scene meshes.
 #[repr(C)]
@@ -79,6 +80,8 @@ pub struct MaterialShader<'a> {
     pass: Pass,
     /// `(instance id, draw id)` for the id pass.
     ids: (f32, f32),
+    /// Emissive texture (see [`MaterialShader::with_emissive_texture`]).
+    emissive_texture: Option<(&'a Texture, Sampler)>,
 }
 
 impl<'a> MaterialShader<'a> {
@@ -101,7 +104,15 @@ impl<'a> MaterialShader<'a> {
             texture,
             pass,
             ids: (ids.0 as f32, ids.1 as f32),
+            emissive_texture: None,
         }
+    }
+
+    /// The same shader reading the material's emissive texture (emission: `material.emissive`
+    /// × this texture at the base colour's texture coordinates, added after lighting).
+    pub fn with_emissive_texture(mut self, texture: Option<(&'a Texture, Sampler)>) -> Self {
+        self.emissive_texture = texture;
+        self
     }
 
     /// The fixed-function state the material asks for: culling unless double-sided, and for
@@ -197,11 +208,37 @@ impl Shader for MaterialShader<'_> {
         let l = self.lighting;
         let n_dot_l = self.normal(fragment).dot(l.to_light).max(0.0);
         let light = Vec3::splat(l.ambient) + (1.0 - l.ambient) * n_dot_l * l.light_color;
-        Some((base.truncate() * light).extend(alpha))
+        // --- emissive (loaders work): added after lighting ---
+        let emissive = self.emissive(fragment);
+        Some((base.truncate() * light + emissive).extend(alpha))
+    }
+
+    #[inline(always)]
+    fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+        self.shade_lanes(fragments)
     }
 }
 
 impl MaterialShader<'_> {
+    /// Emitted colour: `material.emissive` × the emissive texture, if any (loaders work).
+    #[inline]
+    fn emissive(&self, fragment: &Fragment<'_>) -> Vec3 {
+        let mut emissive = self.material.emissive;
+        if let Some((texture, sampler)) = self.emissive_texture {
+            let v = fragment.varyings();
+            let (du_dx, du_dy) = fragment.derivatives(3);
+            let (dv_dx, dv_dy) = fragment.derivatives(4);
+            let sample = texture.sample_grad(
+                &sampler,
+                Vec2::new(v[3], v[4]),
+                Vec2::new(du_dx, dv_dx),
+                Vec2::new(du_dy, dv_dy),
+            );
+            emissive *= sample.truncate();
+        }
+        emissive
+    }
+
     /// The value of the normals or ids pass.
     #[inline]
     fn auxiliary(&self, fragment: &Fragment<'_>) -> Vec4 {
@@ -213,6 +250,189 @@ impl MaterialShader<'_> {
                 self.ids.1,
                 1.0,
             ),
+        }
+    }
+}
+
+/// The lane-wide fragment program: the same operations as [`Shader::fragment`] above, in the same
+/// order, on eight pixels at once.
+impl MaterialShader<'_> {
+    #[inline(always)]
+    fn shade_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+        let lanes = f.lanes;
+        let all = lanes.mask_all(true);
+        let needs_alpha = !matches!(self.material.alpha_mode, AlphaMode::Opaque);
+        if self.pass != Pass::Color && !needs_alpha {
+            return ShadedLanes {
+                color: self.auxiliary_lanes(f),
+                keep: all,
+            };
+        }
+        let base = self.base_color_lanes(f);
+        let (alpha, keep) = match self.material.alpha_mode {
+            AlphaMode::Opaque => (lanes.splat_f32(1.0), all),
+            AlphaMode::Mask { cutoff } => (
+                lanes.splat_f32(1.0),
+                base[3].simd_lt(lanes.splat_f32(cutoff)).not(),
+            ),
+            AlphaMode::Blend => (base[3], all),
+        };
+        if self.pass != Pass::Color {
+            return ShadedLanes {
+                color: self.auxiliary_lanes(f),
+                keep,
+            };
+        }
+        if self.material.unlit {
+            return ShadedLanes {
+                color: [base[0], base[1], base[2], alpha],
+                keep,
+            };
+        }
+        let l = self.lighting;
+        let n = self.normal_lanes(f);
+        let n_dot_l = (n[0] * lanes.splat_f32(l.to_light.x)
+            + n[1] * lanes.splat_f32(l.to_light.y)
+            + n[2] * lanes.splat_f32(l.to_light.z))
+        .max(lanes.splat_f32(0.0));
+        let diffuse = lanes.splat_f32(1.0 - l.ambient) * n_dot_l;
+        let ambient = lanes.splat_f32(l.ambient);
+        let light = [
+            ambient + diffuse * lanes.splat_f32(l.light_color.x),
+            ambient + diffuse * lanes.splat_f32(l.light_color.y),
+            ambient + diffuse * lanes.splat_f32(l.light_color.z),
+        ];
+        let emissive = self.emissive_lanes(f);
+        ShadedLanes {
+            color: [
+                base[0] * light[0] + emissive[0],
+                base[1] * light[1] + emissive[1],
+                base[2] * light[2] + emissive[2],
+                alpha,
+            ],
+            keep,
+        }
+    }
+
+    /// [`MaterialShader::emissive`] per lane; the texture is sampled lane by lane.
+    #[inline(always)]
+    fn emissive_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 3] {
+        let lanes = f.lanes;
+        let e = self.material.emissive;
+        let mut emissive = [
+            lanes.splat_f32(e.x),
+            lanes.splat_f32(e.y),
+            lanes.splat_f32(e.z),
+        ];
+        if let Some((texture, sampler)) = self.emissive_texture {
+            let (u, v) = (f.varying(3).to_array(), f.varying(4).to_array());
+            let (du_dx, du_dy) = f.derivatives(3);
+            let (dv_dx, dv_dy) = f.derivatives(4);
+            let (du_dx, du_dy) = (du_dx.to_array(), du_dy.to_array());
+            let (dv_dx, dv_dy) = (dv_dx.to_array(), dv_dy.to_array());
+            let active = f.active.bits();
+            let mut texel = [[0.0f32; 8]; 3];
+            for k in 0..8 {
+                if active & (1 << k) == 0 {
+                    continue;
+                }
+                let t = texture.sample_grad(
+                    &sampler,
+                    Vec2::new(u[k], v[k]),
+                    Vec2::new(du_dx[k], dv_dx[k]),
+                    Vec2::new(du_dy[k], dv_dy[k]),
+                );
+                texel[0][k] = t.x;
+                texel[1][k] = t.y;
+                texel[2][k] = t.z;
+            }
+            for c in 0..3 {
+                emissive[c] = emissive[c] * lanes.f32_from_array(texel[c]);
+            }
+        }
+        emissive
+    }
+
+    /// `baseColorFactor × COLOR_0 × texture(uv)` per lane; the texture is sampled lane by lane.
+    #[inline(always)]
+    fn base_color_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 4] {
+        let lanes = f.lanes;
+        let factor = self.material.base_color_factor.to_array();
+        let mut base = [
+            lanes.splat_f32(factor[0]) * f.varying(5),
+            lanes.splat_f32(factor[1]) * f.varying(6),
+            lanes.splat_f32(factor[2]) * f.varying(7),
+            lanes.splat_f32(factor[3]) * f.varying(8),
+        ];
+        if let Some((texture, sampler)) = self.texture {
+            let (u, v) = (f.varying(3).to_array(), f.varying(4).to_array());
+            let (du_dx, du_dy) = f.derivatives(3);
+            let (dv_dx, dv_dy) = f.derivatives(4);
+            let (du_dx, du_dy) = (du_dx.to_array(), du_dy.to_array());
+            let (dv_dx, dv_dy) = (dv_dx.to_array(), dv_dy.to_array());
+            let active = f.active.bits();
+            let mut texel = [[0.0f32; 8]; 4];
+            for k in 0..8 {
+                if active & (1 << k) == 0 {
+                    continue;
+                }
+                let t = texture.sample_grad(
+                    &sampler,
+                    Vec2::new(u[k], v[k]),
+                    Vec2::new(du_dx[k], dv_dx[k]),
+                    Vec2::new(du_dy[k], dv_dy[k]),
+                );
+                for (channel, value) in texel.iter_mut().zip(t.to_array()) {
+                    channel[k] = value;
+                }
+            }
+            for c in 0..4 {
+                base[c] = base[c] * lanes.f32_from_array(texel[c]);
+            }
+        }
+        base
+    }
+
+    /// The interpolated world normal, renormalised (zero when degenerate, as
+    /// `Vec3::normalize_or_zero`), flipped on back faces of double-sided materials.
+    #[inline(always)]
+    fn normal_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 3] {
+        let lanes = f.lanes;
+        let n = [f.varying(0), f.varying(1), f.varying(2)];
+        let length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
+        let rcp = lanes.splat_f32(1.0) / length2.sqrt();
+        let usable = rcp
+            .abs()
+            .simd_lt(lanes.splat_f32(f32::INFINITY))
+            .and(rcp.simd_gt(lanes.splat_f32(0.0)));
+        let zero = lanes.splat_f32(0.0);
+        let n = [
+            usable.select_f32(n[0] * rcp, zero),
+            usable.select_f32(n[1] * rcp, zero),
+            usable.select_f32(n[2] * rcp, zero),
+        ];
+        if self.material.double_sided && !f.front_facing {
+            [-n[0], -n[1], -n[2]]
+        } else {
+            n
+        }
+    }
+
+    /// The value of the normals or ids pass, per lane.
+    #[inline(always)]
+    fn auxiliary_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 4] {
+        let lanes = f.lanes;
+        match self.pass {
+            Pass::Normals => {
+                let n = self.normal_lanes(f);
+                [n[0], n[1], n[2], lanes.splat_f32(1.0)]
+            }
+            _ => [
+                lanes.splat_f32(self.ids.0),
+                lanes.splat_f32(f.primitive_id as f32 + 1.0),
+                lanes.splat_f32(self.ids.1),
+                lanes.splat_f32(1.0),
+            ],
         }
     }
 }

@@ -7,93 +7,32 @@
 
 use glam::Vec4;
 
+pub use crate::state::{BlendMode, DepthFunc};
+
 use crate::error::RenderError;
-use crate::fixed::{TILE_LOG2, TILE_PIXELS, TILE_SIZE};
+use crate::fixed::{BLOCK_LOG2, TILE_LOG2, TILE_PIXELS, TILE_SIZE};
+
+/// 8 × 8 blocks in a tile (64).
+const BLOCKS_PER_TILE: usize = ((TILE_SIZE >> BLOCK_LOG2) * (TILE_SIZE >> BLOCK_LOG2)) as usize;
 use crate::raster::bin::TileGrid;
 use crate::setup::PixelRect;
 
-/// Depth comparison: a fragment passes when `fragment_depth OP stored_depth` holds.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum DepthFunc {
-    /// Never passes.
-    Never,
-    /// Passes when closer.
-    #[default]
-    Less,
-    /// Passes when equal.
-    Equal,
-    /// Passes when closer or equal.
-    LessEqual,
-    /// Passes when farther.
-    Greater,
-    /// Passes when different.
-    NotEqual,
-    /// Passes when farther or equal.
-    GreaterEqual,
-    /// Always passes.
-    Always,
-}
-
-impl DepthFunc {
-    /// Whether a fragment at depth `fragment` passes against `stored`.
-    #[inline]
-    pub fn passes(self, fragment: f32, stored: f32) -> bool {
-        match self {
-            DepthFunc::Never => false,
-            DepthFunc::Less => fragment < stored,
-            DepthFunc::Equal => fragment == stored,
-            DepthFunc::LessEqual => fragment <= stored,
-            DepthFunc::Greater => fragment > stored,
-            DepthFunc::NotEqual => fragment != stored,
-            DepthFunc::GreaterEqual => fragment >= stored,
-            DepthFunc::Always => true,
-        }
-    }
-}
-
-/// How a fragment's colour combines with the stored one (all in linear space).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum BlendMode {
-    /// `dst = src`.
-    #[default]
-    Replace,
-    /// Porter–Duff "over" with premultiplied colours: `dst = src + dst × (1 − src.a)`.
-    PremultipliedOver,
-    /// Classic alpha blending: `dst.rgb = src.rgb × src.a + dst.rgb × (1 − src.a)`,
-    /// `dst.a = src.a + dst.a × (1 − src.a)`.
-    Alpha,
-    /// `dst = src + dst`.
-    Additive,
-}
-
-impl BlendMode {
-    /// The blended colour.
-    #[inline]
-    pub fn blend(self, src: Vec4, dst: Vec4) -> Vec4 {
-        match self {
-            BlendMode::Replace => src,
-            BlendMode::PremultipliedOver => src + dst * (1.0 - src.w),
-            BlendMode::Alpha => {
-                let a = src.w;
-                let rgb = src.truncate() * a + dst.truncate() * (1.0 - a);
-                rgb.extend(a + dst.w * (1.0 - a))
-            }
-            BlendMode::Additive => src + dst,
-        }
-    }
-}
-
-/// One tile's colour and depth, `TILE_SIZE × TILE_SIZE`, row-major within the tile.
+/// One tile's colour and depth, `TILE_SIZE × TILE_SIZE`, row-major within the tile. Colour is
+/// stored as four planes (red, green, blue, alpha; structure of arrays) so that eight adjacent
+/// pixels of a row are one lane load per channel.
 #[derive(Clone, Debug)]
 pub struct TileBuffer {
-    /// Linear RGBA.
-    pub color: Vec<Vec4>,
+    /// Linear colour planes: red at `0..TILE_PIXELS`, then green, blue and alpha.
+    color: Vec<f32>,
     /// Window depth.
-    pub depth: Vec<f32>,
+    depth: Vec<f32>,
     /// An upper bound of every value in `depth` (kept by every depth write).
     depth_bound: f32,
     /// Whether `depth_bound` is the exact maximum (false after writes until recomputed).
     depth_bound_exact: bool,
+    /// The largest depth of each 8 × 8 block (row-major blocks of the tile), kept exact by the
+    /// per-pixel path after every block it writes: the second level of the depth hierarchy.
+    block_depth_max: [f32; BLOCKS_PER_TILE],
 }
 
 /// Margin below a triangle's smallest vertex depth. Interpolated depth is clamped to the
@@ -107,19 +46,110 @@ const DEPTH_BOUND_REFRESH_AREA: i32 = 1024;
 impl TileBuffer {
     fn new() -> Result<Self, RenderError> {
         Ok(Self {
-            color: filled_vec(TILE_PIXELS, Vec4::ZERO)?,
+            color: filled_vec(4 * TILE_PIXELS, 0.0)?,
             depth: filled_vec(TILE_PIXELS, 1.0)?,
             depth_bound: 1.0,
             depth_bound_exact: true,
+            block_depth_max: [1.0; BLOCKS_PER_TILE],
         })
     }
 
-    /// Writes a depth value, keeping the tile's bound valid.
+    /// Depths of the row starting at tile index `index` (to the end of the tile).
+    #[inline(always)]
+    pub fn depth_row(&self, index: usize) -> &[f32] {
+        &self.depth[index..]
+    }
+
+    /// Mutable depths of the row starting at tile index `index`; call
+    /// [`TileBuffer::note_depth_written`] after writing.
+    #[inline(always)]
+    pub fn depth_row_mut(&mut self, index: usize) -> &mut [f32] {
+        &mut self.depth[index..]
+    }
+
+    /// The four colour planes from tile index `index` on.
+    #[inline(always)]
+    pub fn color_row(&self, index: usize) -> [&[f32]; 4] {
+        let (r, rest) = self.color.split_at(TILE_PIXELS);
+        let (g, rest) = rest.split_at(TILE_PIXELS);
+        let (b, a) = rest.split_at(TILE_PIXELS);
+        [&r[index..], &g[index..], &b[index..], &a[index..]]
+    }
+
+    /// The four colour planes from tile index `index` on, mutable.
+    #[inline(always)]
+    pub fn color_row_mut(&mut self, index: usize) -> [&mut [f32]; 4] {
+        let (r, rest) = self.color.split_at_mut(TILE_PIXELS);
+        let (g, rest) = rest.split_at_mut(TILE_PIXELS);
+        let (b, a) = rest.split_at_mut(TILE_PIXELS);
+        [
+            &mut r[index..],
+            &mut g[index..],
+            &mut b[index..],
+            &mut a[index..],
+        ]
+    }
+
+    /// The colour of the pixel at tile index `index`.
     #[inline]
-    pub fn write_depth(&mut self, index: usize, depth: f32) {
-        self.depth[index] = depth;
-        self.depth_bound = self.depth_bound.max(depth);
+    pub fn color_at(&self, index: usize) -> Vec4 {
+        Vec4::new(
+            self.color[index],
+            self.color[TILE_PIXELS + index],
+            self.color[2 * TILE_PIXELS + index],
+            self.color[3 * TILE_PIXELS + index],
+        )
+    }
+
+    /// The depth of the pixel at tile index `index`.
+    #[inline]
+    pub fn depth_at(&self, index: usize) -> f32 {
+        self.depth[index]
+    }
+
+    /// Index of the 8 × 8 block holding absolute pixel `(x, y)` within its tile.
+    #[inline(always)]
+    pub fn block_index(x: i32, y: i32) -> usize {
+        let mask = (TILE_SIZE >> BLOCK_LOG2) as i32 - 1;
+        ((((y >> BLOCK_LOG2) & mask) << (TILE_LOG2 - BLOCK_LOG2)) | ((x >> BLOCK_LOG2) & mask))
+            as usize
+    }
+
+    /// Whether a triangle whose vertex depths are at least `min_depth` fails a LESS or LEQUAL
+    /// test on every pixel of block `block` (so the block can be skipped).
+    #[inline(always)]
+    pub fn block_occludes(&self, block: usize, min_depth: f32) -> bool {
+        min_depth - DEPTH_BOUND_SLACK > self.block_depth_max[block]
+    }
+
+    /// Records the exact largest depth of block `block` after the per-pixel path wrote it, and
+    /// keeps the tile's bound valid.
+    #[inline(always)]
+    pub fn set_block_depth_max(&mut self, block: usize, max_depth: f32) {
+        self.block_depth_max[block] = max_depth;
+        self.note_depth_written(max_depth);
+    }
+
+    /// Records that depths up to `max_depth` were written, keeping the tile's bound valid.
+    #[inline]
+    pub fn note_depth_written(&mut self, max_depth: f32) {
+        self.depth_bound = self.depth_bound.max(max_depth);
         self.depth_bound_exact = false;
+    }
+
+    /// Fills colour and/or depth.
+    fn fill(&mut self, color: Option<Vec4>, depth: Option<f32>) {
+        if let Some(c) = color {
+            for (plane, value) in self.color.chunks_exact_mut(TILE_PIXELS).zip(c.to_array()) {
+                plane.fill(value);
+            }
+        }
+        if let Some(d) = depth {
+            self.depth.fill(d);
+            self.depth_bound = d;
+            self.depth_bound_exact = true;
+            self.block_depth_max = [d; BLOCKS_PER_TILE];
+        }
     }
 
     /// Whether every fragment of a triangle whose vertex depths are at least `min_depth` would
@@ -220,16 +250,9 @@ impl Framebuffer {
     /// Sets every pixel's colour and/or depth.
     pub fn clear(&mut self, color: Option<Vec4>, depth: Option<f32>) {
         use rayon::prelude::*;
-        self.tiles.par_iter_mut().for_each(|tile| {
-            if let Some(c) = color {
-                tile.color.fill(c);
-            }
-            if let Some(d) = depth {
-                tile.depth.fill(d);
-                tile.depth_bound = d;
-                tile.depth_bound_exact = true;
-            }
-        });
+        self.tiles
+            .par_iter_mut()
+            .for_each(|tile| tile.fill(color, depth));
     }
 
     fn read<T: Copy>(&self, mut get: impl FnMut(&TileBuffer, usize) -> T) -> Vec<T> {
@@ -249,12 +272,12 @@ impl Framebuffer {
 
     /// Linear RGBA, row-major, row 0 = top.
     pub fn read_color(&self) -> Vec<[f32; 4]> {
-        self.read(|t, i| t.color[i].to_array())
+        self.read(|t, i| t.color_at(i).to_array())
     }
 
     /// 8-bit RGBA, row-major, row 0 = top; RGB sRGB-encoded when `srgb` is set.
     pub fn read_rgba8(&self, srgb: bool) -> Vec<u8> {
-        self.read(|t, i| crate::color::encode_rgba8(t.color[i].to_array(), srgb))
+        self.read(|t, i| crate::color::encode_rgba8(t.color_at(i).to_array(), srgb))
             .into_iter()
             .flatten()
             .collect()
@@ -277,7 +300,7 @@ impl Framebuffer {
 
     /// Colour of one pixel (`None` outside the target).
     pub fn pixel(&self, x: u32, y: u32) -> Option<Vec4> {
-        self.locate(x, y).map(|(tile, i)| tile.color[i])
+        self.locate(x, y).map(|(tile, i)| tile.color_at(i))
     }
 
     /// Depth of one pixel (`None` outside the target).

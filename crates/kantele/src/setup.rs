@@ -9,28 +9,7 @@
 use glam::Vec4;
 
 use crate::fixed::{pixel_center, snap, SUBPIXEL_ONE};
-
-/// Which faces are removed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum CullMode {
-    /// Draw both faces.
-    None,
-    /// Remove back faces.
-    #[default]
-    Back,
-    /// Remove front faces.
-    Front,
-}
-
-/// Which winding (in normalized device coordinates, y up) is the front face.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
-pub enum FrontFace {
-    /// Counter-clockwise is front (OpenGL's and glTF's default).
-    #[default]
-    Ccw,
-    /// Clockwise is front.
-    Cw,
-}
+pub use crate::state::{CullMode, FrontFace};
 
 /// A half-open rectangle of pixels `[x0, x1) × [y0, y1)`.
 #[repr(C)]

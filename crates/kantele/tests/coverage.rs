@@ -6,6 +6,7 @@ use kantele::pipeline::{FnShader, Fragment, Indices, RenderState, Renderer, Rend
 use kantele::raster::Strategy;
 use kantele::rop::{BlendMode, DepthFunc};
 use kantele::setup::CullMode;
+use kantele::simd::Isa;
 use proptest::prelude::*;
 
 /// A shader that adds 1 to the red channel per fragment: the result counts coverage.
@@ -205,7 +206,7 @@ proptest! {
             fine
         };
         let vertices = vec![Vec2::new(c[0], c[1]), Vec2::new(c[2], c[3]), Vec2::new(c[4], c[5])];
-        let options = RendererOptions { threads: Some(1), strategy };
+        let options = RendererOptions { threads: Some(1), strategy, ..RendererOptions::default() };
         let counts = coverage_counts((w, h), &vertices, &[0, 1, 2], options);
         let snapped = [snap_ndc(vertices[0], w, h), snap_ndc(vertices[1], w, h), snap_ndc(vertices[2], w, h)];
         for y in 0..h {
@@ -266,13 +267,14 @@ fn every_strategy_and_thread_count_renders_the_same_image() {
             Some(Vec4::new(v[0], v[1], v[2], v[3]))
         },
     );
-    let render = |threads: usize, strategy: Strategy| {
+    let render = |threads: usize, strategy: Strategy, isa: Isa| {
         let mut renderer = Renderer::new(
             301,
             203,
             RendererOptions {
                 threads: Some(threads),
                 strategy,
+                isa: Some(isa),
             },
         )
         .expect("renderer");
@@ -298,19 +300,26 @@ fn every_strategy_and_thread_count_renders_the_same_image() {
             renderer.framebuffer().read_depth(),
         )
     };
-    let reference = render(1, Strategy::BoundingBox);
+    let reference = render(1, Strategy::BoundingBox, Isa::Scalar);
     let covered = reference.1.iter().filter(|d| **d < 1.0).count();
     assert!(
         covered > 10_000,
         "scene should cover much of the target ({covered})"
     );
-    for threads in [1, 2, 3, 8] {
-        for strategy in Strategy::ALL {
-            let image = render(threads, strategy);
-            assert!(
-                image == reference,
-                "{strategy} with {threads} threads differs"
-            );
+    let isas: Vec<Isa> = Isa::ALL.into_iter().filter(|i| i.is_supported()).collect();
+    assert!(
+        isas.len() > 1 || cfg!(not(target_arch = "x86_64")),
+        "{isas:?}"
+    );
+    for isa in isas {
+        for threads in [1, 2, 3, 8] {
+            for strategy in Strategy::ALL {
+                let image = render(threads, strategy, isa);
+                assert!(
+                    image == reference,
+                    "{strategy} with {threads} threads on {isa} differs"
+                );
+            }
         }
     }
 }

@@ -92,7 +92,7 @@ static void texture() {
         at += n;
     }
     TextureRecord tex = {0, count, levels[0].width, levels[0].height};
-    DrawRecord d = {};
+    SamplerCodes d = {};
     if (std::scanf("%u %u %u %u", &d.wrap_s, &d.wrap_t, &d.mag_filter, &d.min_filter) != 4) std::exit(1);
     float u = read_float(), v = read_float(), lod = read_float();
     V4 c = sample_lod(texels, tex, levels, d, u, v, lod);

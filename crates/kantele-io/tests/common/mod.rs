@@ -19,15 +19,10 @@ pub fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// The reference scenes, when this checkout has them next to it.
+/// The reference scenes, when this checkout has them next to it (a failure instead of a skip
+/// when `KANTELE_REQUIRE` names `scenes`).
 pub fn reference_scenes() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/scenes");
-    if dir.is_dir() {
-        Some(dir)
-    } else {
-        eprintln!("reference scenes not found at {}; skipping", dir.display());
-        None
-    }
+    kantele_testkit::shared_dir("scenes")
 }
 
 /// A PNG of the given RGBA texels.

@@ -50,45 +50,93 @@ impl TileGrid {
     }
 }
 
-/// Per-tile lists of triangle indices.
+/// Per-tile lists of triangle indices, built in parallel: the frame's triangles are split into
+/// consecutive chunks, each chunk is binned by one thread into lists of its own, and a tile's
+/// triangles are its lists read chunk after chunk — submission order, whatever the thread count,
+/// with no merge copy. Lists keep their allocations from frame to frame.
 #[derive(Clone, Debug, Default)]
 pub struct TileBins {
-    /// `bins[tile]` lists indices into the frame's triangles, in submission order.
-    pub bins: Vec<Vec<u32>>,
+    /// `chunks[c][tile]`: indices of chunk `c`'s triangles touching `tile`, in order (only the
+    /// first `chunk_count` chunks are current).
+    chunks: Vec<Vec<Vec<u32>>>,
+    chunk_count: usize,
+    tile_count: usize,
 }
 
-impl TileBins {
-    /// Empties every bin, keeping allocations, and sizes the list for `grid`.
-    pub fn reset(&mut self, grid: &TileGrid) {
-        self.bins.resize_with(grid.tile_count(), Vec::new);
-        self.bins.truncate(grid.tile_count());
-        for bin in &mut self.bins {
-            bin.clear();
-        }
-    }
+/// Fewest triangles per binning chunk: below this, one thread bins them all.
+const MIN_TRIANGLES_PER_CHUNK: usize = 4096;
 
+impl TileBins {
     /// Appends every triangle to the bins its bounding box touches; returns the number of bin
     /// entries written. A triangle whose box touches a tile but covers none of its pixels is
     /// still binned there; traversal finds no pixel.
     pub fn bin_triangles(&mut self, grid: &TileGrid, triangles: &[TriangleSetup]) -> u64 {
-        self.reset(grid);
-        let mut entries = 0u64;
-        for (index, tri) in triangles.iter().enumerate() {
-            let b = tri.bbox;
-            let tx0 = (b.x0 >> TILE_LOG2) as usize;
-            let tx1 = ((b.x1 - 1) >> TILE_LOG2) as usize;
-            let ty0 = (b.y0 >> TILE_LOG2) as usize;
-            let ty1 = ((b.y1 - 1) >> TILE_LOG2) as usize;
-            for ty in ty0..=ty1 {
-                let row = ty * grid.tiles_x as usize;
-                for tx in tx0..=tx1 {
-                    self.bins[row + tx].push(index as u32);
-                }
-            }
-            entries += ((tx1 - tx0 + 1) * (ty1 - ty0 + 1)) as u64;
+        use rayon::prelude::*;
+        let tile_count = grid.tile_count();
+        let wanted = (2 * rayon::current_num_threads()).max(1);
+        let chunk_count = triangles
+            .len()
+            .div_ceil(MIN_TRIANGLES_PER_CHUNK)
+            .clamp(1, wanted);
+        let per_chunk = triangles.len().div_ceil(chunk_count).max(1);
+        if self.chunks.len() < chunk_count {
+            self.chunks.resize_with(chunk_count, Vec::new);
         }
-        entries
+        self.chunk_count = chunk_count;
+        self.tile_count = tile_count;
+        self.chunks[..chunk_count]
+            .par_iter_mut()
+            .enumerate()
+            .map(|(c, bins)| {
+                bins.resize_with(tile_count, Vec::new);
+                bins.truncate(tile_count);
+                for bin in bins.iter_mut() {
+                    bin.clear();
+                }
+                let first = (c * per_chunk).min(triangles.len());
+                let last = ((c + 1) * per_chunk).min(triangles.len());
+                bin_range(grid, triangles, first..last, bins)
+            })
+            .sum()
     }
+
+    /// The triangles touching `tile`, in submission order.
+    #[inline]
+    pub fn tile(&self, tile: usize) -> impl Iterator<Item = u32> + '_ {
+        self.chunks[..self.chunk_count]
+            .iter()
+            .flat_map(move |bins| bins[tile].iter().copied())
+    }
+
+    /// Number of tiles binned for.
+    pub fn tile_count(&self) -> usize {
+        self.tile_count
+    }
+}
+
+/// Bins triangles `range` (indices into `triangles`) into `bins` (one list per tile).
+fn bin_range(
+    grid: &TileGrid,
+    triangles: &[TriangleSetup],
+    range: std::ops::Range<usize>,
+    bins: &mut [Vec<u32>],
+) -> u64 {
+    let mut entries = 0u64;
+    for index in range {
+        let b = triangles[index].bbox;
+        let tx0 = (b.x0 >> TILE_LOG2) as usize;
+        let tx1 = ((b.x1 - 1) >> TILE_LOG2) as usize;
+        let ty0 = (b.y0 >> TILE_LOG2) as usize;
+        let ty1 = ((b.y1 - 1) >> TILE_LOG2) as usize;
+        for ty in ty0..=ty1 {
+            let row = ty * grid.tiles_x as usize;
+            for bin in &mut bins[row + tx0..=row + tx1] {
+                bin.push(index as u32);
+            }
+        }
+        entries += ((tx1 - tx0 + 1) * (ty1 - ty0 + 1)) as u64;
+    }
+    entries
 }
 
 #[cfg(test)]
@@ -122,8 +170,48 @@ mod tests {
         let mut bins = TileBins::default();
         let entries = bins.bin_triangles(&grid, &[a, b]);
         assert_eq!(entries, 2 + 16);
-        assert_eq!(bins.bins[0], vec![0, 1]);
-        assert_eq!(bins.bins[1], vec![0, 1]);
-        assert_eq!(bins.bins[2], vec![1]);
+        let tile = |t: usize| bins.tile(t).collect::<Vec<_>>();
+        assert_eq!(tile(0), vec![0, 1]);
+        assert_eq!(tile(1), vec![0, 1]);
+        assert_eq!(tile(2), vec![1]);
+    }
+
+    #[test]
+    fn parallel_chunks_keep_submission_order() {
+        let grid = TileGrid::new(256, 256);
+        // Enough triangles for several chunks; every other one covers tile 0 only.
+        let triangles: Vec<TriangleSetup> = (0..20_000)
+            .map(|i| TriangleSetup {
+                bbox: if i % 2 == 0 {
+                    PixelRect {
+                        x0: 0,
+                        y0: 0,
+                        x1: 8,
+                        y1: 8,
+                    }
+                } else {
+                    PixelRect {
+                        x0: 100,
+                        y0: 100,
+                        x1: 200,
+                        y1: 130,
+                    }
+                },
+                ..TriangleSetup::default()
+            })
+            .collect();
+        for threads in [1, 3, 8] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let mut bins = TileBins::default();
+            pool.install(|| bins.bin_triangles(&grid, &triangles));
+            let tile0: Vec<u32> = bins.tile(0).collect();
+            let expected: Vec<u32> = (0..20_000).step_by(2).collect();
+            assert_eq!(tile0, expected, "{threads} threads");
+            let tile5: Vec<u32> = bins.tile(5).collect();
+            assert_eq!(tile5, (1..20_000).step_by(2).collect::<Vec<u32>>());
+        }
     }
 }

@@ -1,0 +1,63 @@
+//! Test support shared by Kantele's crates.
+//!
+//! A test that cannot run here (no OpenGL driver, no display, no `../shared` data) says why and
+//! skips — unless the environment variable `KANTELE_REQUIRE` (a comma-separated list such as
+//! `gl,display,scenes`) names what it lacks: then it fails, so a CI machine that is meant to have
+//! the thing can never pass by skipping. `.ci/run` sets `KANTELE_REQUIRE` for what CI installs.
+#![warn(missing_docs)]
+#![forbid(unsafe_code)]
+
+use std::fmt::Display;
+use std::path::{Path, PathBuf};
+
+/// Whether `KANTELE_REQUIRE` names `what` (`gl`, `display`, `scenes`, `realworld`, `python`, …).
+pub fn required(what: &str) -> bool {
+    std::env::var("KANTELE_REQUIRE")
+        .unwrap_or_default()
+        .split(',')
+        .any(|w| w.trim() == what)
+}
+
+/// Reports that a test cannot run for want of `what`: prints `skipping: REASON` and returns, or
+/// panics when `KANTELE_REQUIRE` names `what`.
+#[track_caller]
+pub fn skip(what: &str, reason: impl Display) {
+    if required(what) {
+        panic!("KANTELE_REQUIRE names {what}, but {reason}");
+    }
+    eprintln!("skipping: {reason}");
+}
+
+/// The repository's `shared/` folder: `../shared` beside the checkout.
+pub fn shared_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared")
+}
+
+/// `shared/<name>` (`scenes`, `realworld`) when it exists; otherwise [`skip`]s for `name` and
+/// returns `None`.
+#[track_caller]
+pub fn shared_dir(name: &str) -> Option<PathBuf> {
+    let dir = shared_root().join(name);
+    if dir.is_dir() {
+        Some(dir)
+    } else {
+        skip(name, format!("{} is absent", dir.display()));
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn require_list_is_comma_separated() {
+        // Only reads the variable; the test does not change the environment (tests run in
+        // parallel threads).
+        let listed = std::env::var("KANTELE_REQUIRE").unwrap_or_default();
+        for name in listed.split(',').filter(|n| !n.trim().is_empty()) {
+            assert!(required(name.trim()));
+        }
+        assert!(!required("no-such-requirement-name"));
+    }
+}

@@ -1,0 +1,238 @@
+//! Draw calls: the index buffer and the type-erased draw that runs each stage's loop compiled for
+//! its concrete shader.
+
+use glam::Vec4;
+
+use super::fragment::{shade_triangle, RasterCounters};
+use super::geometry::{PrimitiveBatch, ShadedVertices, TargetSpace};
+use super::shader::Shader;
+use crate::geometry::clip::{classify, ClipPolygon, ClipTest, ClipVertex};
+use crate::raster::BlockCoverage;
+use crate::rop::{DepthFunc, TileBuffer};
+use crate::setup::{setup_triangle, SetupReject, TriangleSetup, Viewport};
+use crate::simd::Isa;
+use crate::state::RenderState;
+use crate::MAX_VARYINGS;
+
+/// An index buffer.
+#[derive(Clone, Copy, Debug)]
+pub enum Indices<'a> {
+    /// Vertices taken in order, three per triangle.
+    None,
+    /// 16-bit indices.
+    U16(&'a [u16]),
+    /// 32-bit indices.
+    U32(&'a [u32]),
+}
+
+impl Indices<'_> {
+    #[inline]
+    pub(super) fn get(&self, i: usize) -> usize {
+        match self {
+            Indices::None => i,
+            Indices::U16(ix) => ix[i] as usize,
+            Indices::U32(ix) => ix[i] as usize,
+        }
+    }
+
+    pub(super) fn len(&self, vertex_count: usize) -> usize {
+        match self {
+            Indices::None => vertex_count,
+            Indices::U16(ix) => ix.len(),
+            Indices::U32(ix) => ix.len(),
+        }
+    }
+}
+
+/// A queued draw with its shader type erased; the methods run the stages for it, so the hot
+/// loops inside are compiled for the concrete shader.
+pub(super) trait DrawJob: Sync {
+    fn vertex_count(&self) -> usize;
+    fn varying_count(&self) -> usize;
+    fn triangle_count(&self) -> usize;
+    fn shade_vertices(&self, first: usize, pos: &mut [Vec4], varyings: &mut [f32]);
+    /// Whether a triangle of this draw wholly behind a tile's depth bound can be skipped there:
+    /// the test is LESS or LEQUAL (its fragments would all fail, and shaders have no side
+    /// effects to miss).
+    fn rejects_by_depth_bound(&self) -> bool;
+    fn sort_order(&self, shaded: &ShadedVertices) -> Option<Vec<u32>>;
+    fn assemble(
+        &self,
+        draw: u32,
+        triangles: std::ops::Range<usize>,
+        order: Option<&[u32]>,
+        shaded: &ShadedVertices,
+        target: &TargetSpace,
+        out: &mut PrimitiveBatch,
+    );
+    /// Shades the triangle's pixels in `coverage` into one tile.
+    fn raster(
+        &self,
+        tri: &TriangleSetup,
+        attrs: &[f32],
+        coverage: &BlockCoverage,
+        tile: &mut TileBuffer,
+        isa: Isa,
+    ) -> RasterCounters;
+}
+
+pub(super) struct DrawCall<'a, S: Shader> {
+    pub(super) shader: &'a S,
+    pub(super) vertices: &'a [S::Vertex],
+    pub(super) indices: Indices<'a>,
+    pub(super) state: RenderState,
+}
+
+impl<S: Shader> DrawCall<'_, S> {
+    #[inline]
+    fn triangle_vertices(&self, t: usize) -> [usize; 3] {
+        [
+            self.indices.get(3 * t),
+            self.indices.get(3 * t + 1),
+            self.indices.get(3 * t + 2),
+        ]
+    }
+
+    /// Sets up one (clipped or whole) triangle and appends it with its varyings.
+    #[allow(clippy::too_many_arguments)] // the stage's inputs; bundling them would only rename them
+    fn emit(
+        &self,
+        draw: u32,
+        primitive_id: u32,
+        pos: [Vec4; 3],
+        varyings: [&[f32]; 3],
+        viewport: &Viewport,
+        out: &mut PrimitiveBatch,
+    ) {
+        match setup_triangle(viewport, pos, self.state.cull, self.state.front_face) {
+            Ok(mut tri) => {
+                tri.draw = draw;
+                tri.primitive_id = primitive_id;
+                let order = if tri.swapped { [0, 2, 1] } else { [0, 1, 2] };
+                for v in order {
+                    out.attrs.extend_from_slice(varyings[v]);
+                }
+                out.triangles.push(tri);
+            }
+            Err(SetupReject::Culled) => out.counters.culled += 1,
+            Err(SetupReject::Degenerate) => out.counters.degenerate += 1,
+        }
+    }
+}
+
+impl<S: Shader> DrawJob for DrawCall<'_, S> {
+    fn vertex_count(&self) -> usize {
+        self.vertices.len()
+    }
+
+    fn varying_count(&self) -> usize {
+        self.shader.varying_count()
+    }
+
+    fn triangle_count(&self) -> usize {
+        self.indices.len(self.vertices.len()) / 3
+    }
+
+    fn shade_vertices(&self, first: usize, pos: &mut [Vec4], varyings: &mut [f32]) {
+        let n = self.shader.varying_count();
+        for (i, p) in pos.iter_mut().enumerate() {
+            let out = &mut varyings[i * n..(i + 1) * n];
+            *p = self.shader.vertex(&self.vertices[first + i], out);
+        }
+    }
+
+    fn rejects_by_depth_bound(&self) -> bool {
+        self.state.depth_test
+            && matches!(
+                self.state.depth_func,
+                DepthFunc::Less | DepthFunc::LessEqual
+            )
+    }
+
+    fn sort_order(&self, shaded: &ShadedVertices) -> Option<Vec<u32>> {
+        if !self.state.sort_back_to_front {
+            return None;
+        }
+        let key = |t: usize| {
+            let [a, b, c] = self.triangle_vertices(t);
+            let w = shaded.pos_clip[a].w + shaded.pos_clip[b].w + shaded.pos_clip[c].w;
+            if w.is_nan() {
+                f32::NEG_INFINITY
+            } else {
+                w
+            }
+        };
+        let mut order: Vec<u32> = (0..self.triangle_count() as u32).collect();
+        // Farthest first; a stable sort keeps submission order among equals.
+        order.sort_by(|&a, &b| key(b as usize).total_cmp(&key(a as usize)));
+        Some(order)
+    }
+
+    fn assemble(
+        &self,
+        draw: u32,
+        triangles: std::ops::Range<usize>,
+        order: Option<&[u32]>,
+        shaded: &ShadedVertices,
+        target: &TargetSpace,
+        out: &mut PrimitiveBatch,
+    ) {
+        let TargetSpace { viewport, guard } = target;
+        let n = self.shader.varying_count();
+        for slot in triangles {
+            out.counters.triangles_in += 1;
+            let t = order.map_or(slot, |o| o[slot] as usize);
+            let ix = self.triangle_vertices(t);
+            let pos = ix.map(|i| shaded.pos_clip[i]);
+            if !pos.iter().all(|p| p.is_finite()) {
+                out.counters.invalid += 1;
+                continue;
+            }
+            let vary = ix.map(|i| &shaded.varyings[i * n..(i + 1) * n]);
+            match classify(pos, guard) {
+                ClipTest::Reject => out.counters.rejected += 1,
+                ClipTest::Accept => self.emit(draw, t as u32, pos, vary, viewport, out),
+                ClipTest::Clip => {
+                    out.counters.clipped += 1;
+                    let vertex = |k: usize| {
+                        let mut v = ClipVertex {
+                            pos_clip: pos[k],
+                            varyings: [0.0; MAX_VARYINGS],
+                        };
+                        v.varyings[..n].copy_from_slice(vary[k]);
+                        v
+                    };
+                    let mut poly = ClipPolygon::triangle(vertex(0), vertex(1), vertex(2));
+                    poly.clip(guard, n);
+                    let verts = poly.vertices();
+                    if verts.iter().any(|v| !v.pos_clip.is_finite()) {
+                        out.counters.invalid += 1;
+                        continue;
+                    }
+                    for k in 1..verts.len().saturating_sub(1) {
+                        let (a, b, c) = (&verts[0], &verts[k], &verts[k + 1]);
+                        self.emit(
+                            draw,
+                            t as u32,
+                            [a.pos_clip, b.pos_clip, c.pos_clip],
+                            [&a.varyings[..n], &b.varyings[..n], &c.varyings[..n]],
+                            viewport,
+                            out,
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    fn raster(
+        &self,
+        tri: &TriangleSetup,
+        attrs: &[f32],
+        coverage: &BlockCoverage,
+        tile: &mut TileBuffer,
+        isa: Isa,
+    ) -> RasterCounters {
+        shade_triangle(self, tri, attrs, coverage, tile, isa)
+    }
+}

@@ -1,0 +1,253 @@
+//! The per-pixel path: for each tile, its triangles in submission order — tile depth bound,
+//! coverage as 8 × 8 block masks, then eight pixels of a row at a time (barycentrics, depth, the
+//! early depth test, perspective-correct varyings, the fragment program, blending and the depth
+//! write) in one routine written over [`Lanes`] and compiled once per instruction set.
+//!
+//! The routine performs the same `f32` operations in the same order on every lane and for every
+//! instruction set (no fused multiply-add), so the scalar build — the readable reference — and
+//! the SIMD builds give the same picture bit for bit.
+
+use rayon::prelude::*;
+
+use super::draw::{DrawCall, DrawJob};
+use super::geometry::GeometryOutput;
+use super::shader::{FragmentLanes, Interpolation, Shader};
+use crate::fixed::pixel_center;
+use crate::raster::bin::TileBins;
+use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
+use crate::rop::{Framebuffer, TileBuffer};
+use crate::setup::TriangleSetup;
+use crate::simd::{dispatch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
+
+/// Fragment counters of one tile.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct RasterCounters {
+    pub(super) tile_rejected: u64,
+    pub(super) blocks_rejected: u64,
+    pub(super) covered: u64,
+    pub(super) shaded: u64,
+    pub(super) discarded: u64,
+}
+
+impl RasterCounters {
+    pub(super) fn sum(a: Self, b: Self) -> Self {
+        Self {
+            tile_rejected: a.tile_rejected + b.tile_rejected,
+            blocks_rejected: a.blocks_rejected + b.blocks_rejected,
+            covered: a.covered + b.covered,
+            shaded: a.shaded + b.shaded,
+            discarded: a.discarded + b.discarded,
+        }
+    }
+}
+
+/// Rasterizes every tile's bin, tiles in parallel, each tile's triangles in order.
+pub(super) fn raster_tiles(
+    framebuffer: &mut Framebuffer,
+    bins: &TileBins,
+    geometry: &GeometryOutput,
+    draws: &[Box<dyn DrawJob + '_>],
+    strategy: Strategy,
+    isa: Isa,
+) -> RasterCounters {
+    let grid = *framebuffer.grid();
+    framebuffer
+        .tiles_mut()
+        .par_iter_mut()
+        .enumerate()
+        .map(|(tile_index, tile)| {
+            let rect = grid.tile_rect(tile_index);
+            let mut counters = RasterCounters::default();
+            let mut coverage = BlockCoverage::default();
+            for t in bins.tile(tile_index) {
+                let tri = &geometry.triangles[t as usize];
+                let draw = &draws[tri.draw as usize];
+                // Early rejection: behind everything already in this tile.
+                if draw.rejects_by_depth_bound() {
+                    let r = rect.intersect(&tri.bbox);
+                    let area = r.width() * r.height();
+                    if tile.occludes(tri.depth_range[0], area, &rect) {
+                        counters.tile_rejected += 1;
+                        continue;
+                    }
+                }
+                rasterize_blocks(tri, rect, strategy, &mut coverage);
+                if coverage.is_empty() {
+                    continue;
+                }
+                let attrs = geometry.attrs_of(t as usize, draws);
+                let c = draw.raster(tri, attrs, &coverage, tile, isa);
+                counters = RasterCounters::sum(counters, c);
+            }
+            counters
+        })
+        .reduce(RasterCounters::default, RasterCounters::sum)
+}
+
+/// Shades one triangle's covered pixels in one tile with the instruction set `isa`.
+pub(super) fn shade_triangle<S: Shader>(
+    draw: &DrawCall<'_, S>,
+    tri: &TriangleSetup,
+    attrs: &[f32],
+    coverage: &BlockCoverage,
+    tile: &mut TileBuffer,
+    isa: Isa,
+) -> RasterCounters {
+    dispatch(
+        isa,
+        ShadeTriangle {
+            draw,
+            tri,
+            attrs,
+            coverage,
+            tile,
+        },
+    )
+}
+
+/// One triangle in one tile, as a kernel compiled per instruction set.
+struct ShadeTriangle<'k, 'a, S: Shader> {
+    draw: &'k DrawCall<'a, S>,
+    tri: &'k TriangleSetup,
+    attrs: &'k [f32],
+    coverage: &'k BlockCoverage,
+    tile: &'k mut TileBuffer,
+}
+
+impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
+    type Output = RasterCounters;
+
+    #[inline(always)]
+    fn run<L: Lanes>(self, lanes: L) -> RasterCounters {
+        let ShadeTriangle {
+            draw,
+            tri,
+            attrs,
+            coverage,
+            tile,
+        } = self;
+        let state = &draw.state;
+        let shader = draw.shader;
+        let (dl_dx, dl_dy) = tri.barycentric_gradients();
+        let interpolation = Interpolation {
+            attrs,
+            varying_count: shader.varying_count(),
+            inv_w: tri.inv_w,
+            dl_dx,
+            dl_dy,
+        };
+        let splat = |v: f32| lanes.splat_f32(v);
+        let g = tri.bary_gradient;
+        let (g1x, g1y, g2x, g2y) = (
+            splat(g[0][0]),
+            splat(g[0][1]),
+            splat(g[1][0]),
+            splat(g[1][1]),
+        );
+        let z = tri.depth.map(splat);
+        let (z_min, z_max) = (splat(tri.depth_range[0]), splat(tri.depth_range[1]));
+        let inv_w = tri.inv_w.map(splat);
+        let (zero, one) = (splat(0.0), splat(1.0));
+        let [v0x, v0y] = tri.pos_subpixel[0];
+        // Sub-pixel offsets of the eight lanes' centres from lane 0's.
+        let lane_offset = lanes
+            .lane_index()
+            .shl::<{ crate::fixed::SUBPIXEL_BITS as i32 }>();
+        let mut counters = RasterCounters::default();
+        let blocks_can_reject = draw.rejects_by_depth_bound();
+
+        for block in coverage.blocks() {
+            // Depth hierarchy, second level: a block whose every stored depth is in front of the
+            // triangle's nearest vertex is skipped (LESS / LEQUAL only; shaders are pure).
+            let block_index = TileBuffer::block_index(block.x, block.y);
+            if blocks_can_reject && tile.block_occludes(block_index, tri.depth_range[0]) {
+                counters.blocks_rejected += 1;
+                continue;
+            }
+            let mut wrote_depth = false;
+            for row in 0..8 {
+                let row_bits = (block.mask >> (8 * row)) as u8;
+                if row_bits == 0 {
+                    continue;
+                }
+                counters.covered += row_bits.count_ones() as u64;
+                let (x, y) = (block.x, block.y + row);
+                // Barycentrics from vertex 0 (`TriangleSetup::barycentrics`): the offsets are
+                // exact integers (|d| < 2^31), converted to f32 with round-to-nearest-even.
+                let dx =
+                    (lanes.splat_i32((pixel_center(x as i64) - v0x) as i32) + lane_offset).to_f32();
+                let dy = lanes.splat_f32((pixel_center(y as i64) - v0y) as f32);
+                let l1 = g1x * dx + g1y * dy;
+                let l2 = g2x * dx + g2y * dy;
+                let l0 = one - l1 - l2;
+                // Affine depth, clamped to the vertex range (`TriangleSetup::depth_at`).
+                let depth = (l0 * z[0] + l1 * z[1] + l2 * z[2]).max(z_min).min(z_max);
+                // Outside [0, 1] (or NaN): beyond the near or far plane.
+                let mut active = lanes
+                    .mask_from_bits(row_bits)
+                    .and(depth.simd_ge(zero))
+                    .and(depth.simd_le(one));
+                let index = TileBuffer::index(x, y);
+                if state.depth_test {
+                    let stored = lanes.load_f32(tile.depth_row(index));
+                    active = active.and(state.depth_func.passes_lanes(lanes, depth, stored));
+                }
+                if active.none() {
+                    continue;
+                }
+                // Perspective-correct weights.
+                let q = [l0 * inv_w[0], l1 * inv_w[1], l2 * inv_w[2]];
+                let w = one / (q[0] + q[1] + q[2]);
+                let fragments = FragmentLanes {
+                    lanes,
+                    x: x as u32,
+                    y: y as u32,
+                    active,
+                    depth,
+                    primitive_id: tri.primitive_id,
+                    front_facing: tri.front_facing,
+                    weights: [q[0] * w, q[1] * w, q[2] * w],
+                    w,
+                    interpolation: &interpolation,
+                };
+                let shaded = shader.fragment_lanes(&fragments);
+                let keep = active.and(shaded.keep);
+                let active_count = active.count() as u64;
+                let kept = keep.count() as u64;
+                counters.shaded += active_count;
+                counters.discarded += active_count - kept;
+                if kept == 0 {
+                    continue;
+                }
+                let [r, g, b, a] = tile.color_row(index);
+                let dst = [
+                    lanes.load_f32(r),
+                    lanes.load_f32(g),
+                    lanes.load_f32(b),
+                    lanes.load_f32(a),
+                ];
+                let blended = state.blend.blend_lanes(lanes, shaded.color, dst);
+                let [r, g, b, a] = tile.color_row_mut(index);
+                blended[0].store_masked(keep, r);
+                blended[1].store_masked(keep, g);
+                blended[2].store_masked(keep, b);
+                blended[3].store_masked(keep, a);
+                if state.depth_write {
+                    depth.store_masked(keep, tile.depth_row_mut(index));
+                    wrote_depth = true;
+                }
+            }
+            if wrote_depth {
+                // Keep the block's bound exact: the largest of its 64 depths.
+                let first = TileBuffer::index(block.x, block.y);
+                let row_stride = crate::fixed::TILE_SIZE as usize;
+                let mut largest = lanes.load_f32(tile.depth_row(first));
+                for row in 1..8 {
+                    largest = largest.max(lanes.load_f32(tile.depth_row(first + row * row_stride)));
+                }
+                tile.set_block_depth_max(block_index, largest.reduce_max());
+            }
+        }
+        counters
+    }
+}

@@ -1,0 +1,222 @@
+//! The geometry stages: the vertex stage (the shader's vertex program on every vertex) and the
+//! primitive stage (assembly, trivial reject, clipping, culling and triangle setup), both parallel
+//! over chunks with their results concatenated in submission order.
+
+use glam::Vec4;
+use rayon::prelude::*;
+
+use super::draw::DrawJob;
+use crate::geometry::clip::GuardBand;
+use crate::setup::{TriangleSetup, Viewport};
+use crate::stats::FrameStats;
+
+/// Triangle counters of the primitive stage.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct PrimitiveCounters {
+    pub(super) triangles_in: u64,
+    pub(super) invalid: u64,
+    pub(super) rejected: u64,
+    pub(super) clipped: u64,
+    pub(super) culled: u64,
+    pub(super) degenerate: u64,
+}
+
+impl PrimitiveCounters {
+    fn sum(a: Self, b: Self) -> Self {
+        Self {
+            triangles_in: a.triangles_in + b.triangles_in,
+            invalid: a.invalid + b.invalid,
+            rejected: a.rejected + b.rejected,
+            clipped: a.clipped + b.clipped,
+            culled: a.culled + b.culled,
+            degenerate: a.degenerate + b.degenerate,
+        }
+    }
+}
+
+/// The frame's set-up triangles (in draw order) and their varyings.
+#[derive(Default)]
+pub(super) struct GeometryOutput {
+    pub(super) triangles: Vec<TriangleSetup>,
+    /// Varyings of every triangle's three vertices, concatenated in triangle order.
+    pub(super) attrs: Vec<f32>,
+    /// Per draw: index of its first triangle and of its first varying in `attrs`.
+    pub(super) draw_first: Vec<(usize, usize)>,
+}
+
+impl GeometryOutput {
+    #[inline]
+    pub(super) fn attrs_of<'s>(
+        &'s self,
+        triangle: usize,
+        draws: &[Box<dyn DrawJob + '_>],
+    ) -> &'s [f32] {
+        let draw = self.triangles[triangle].draw as usize;
+        let n3 = 3 * draws[draw].varying_count();
+        let (first_tri, first_attr) = self.draw_first[draw];
+        let start = first_attr + (triangle - first_tri) * n3;
+        &self.attrs[start..start + n3]
+    }
+}
+
+/// Triangles per unit of parallel work in the primitive stage.
+const PRIMITIVE_CHUNK: usize = 1024;
+/// Vertices per unit of parallel work in the vertex stage.
+const VERTEX_CHUNK: usize = 2048;
+
+/// Output of the vertex stage for one draw.
+#[derive(Default)]
+pub(super) struct ShadedVertices {
+    pub(super) pos_clip: Vec<Vec4>,
+    pub(super) varyings: Vec<f32>,
+}
+
+/// The part of a draw the primitive stage produces for a range of its triangles.
+#[derive(Default)]
+pub(super) struct PrimitiveBatch {
+    pub(super) triangles: Vec<TriangleSetup>,
+    pub(super) attrs: Vec<f32>,
+    pub(super) counters: PrimitiveCounters,
+}
+
+impl PrimitiveBatch {
+    pub(super) fn clear(&mut self) {
+        self.triangles.clear();
+        self.attrs.clear();
+        self.counters = PrimitiveCounters::default();
+    }
+}
+
+/// Where triangles are set up: the viewport and its guard band.
+pub(super) struct TargetSpace {
+    pub(super) viewport: Viewport,
+    pub(super) guard: GuardBand,
+}
+
+/// Buffers of the geometry stages, kept by the renderer between frames so that a frame reuses
+/// the previous one's allocations instead of paging fresh memory in and out.
+#[derive(Default)]
+pub(super) struct GeometryScratch {
+    /// Vertex-stage output per draw (only the first `draws.len()` are current).
+    pub(super) shaded: Vec<ShadedVertices>,
+    /// Primitive-stage output per chunk (only the first `jobs` are current).
+    pub(super) batches: Vec<PrimitiveBatch>,
+    /// The frame's triangles and varyings.
+    pub(super) output: GeometryOutput,
+}
+
+pub(super) fn run_geometry(
+    draws: &[Box<dyn DrawJob + '_>],
+    viewport: &Viewport,
+    stats: &mut FrameStats,
+    scratch: &mut GeometryScratch,
+) {
+    let GeometryScratch {
+        shaded,
+        batches,
+        output,
+    } = scratch;
+    // 1. Vertex stage over all draws, in chunks.
+    if shaded.len() < draws.len() {
+        shaded.resize_with(draws.len(), ShadedVertices::default);
+    }
+    let shaded = &mut shaded[..draws.len()];
+    for (d, out) in draws.iter().zip(shaded.iter_mut()) {
+        out.pos_clip.clear();
+        out.pos_clip.resize(d.vertex_count(), Vec4::ZERO);
+        out.varyings.clear();
+        out.varyings
+            .resize(d.vertex_count() * d.varying_count(), 0.0);
+    }
+    let mut vertex_jobs = Vec::new();
+    for (draw, out) in shaded.iter_mut().enumerate() {
+        let n = draws[draw].varying_count();
+        let vary_chunks: Box<dyn Iterator<Item = &mut [f32]>> = if n == 0 {
+            Box::new(std::iter::repeat_with(|| &mut [][..]))
+        } else {
+            Box::new(out.varyings.chunks_mut(VERTEX_CHUNK * n))
+        };
+        for (chunk, (pos, vary)) in out
+            .pos_clip
+            .chunks_mut(VERTEX_CHUNK)
+            .zip(vary_chunks)
+            .enumerate()
+        {
+            vertex_jobs.push((draw, chunk * VERTEX_CHUNK, pos, vary));
+        }
+    }
+    vertex_jobs
+        .into_par_iter()
+        .for_each(|(draw, first, pos, vary)| draws[draw].shade_vertices(first, pos, vary));
+    let shaded = &*shaded;
+
+    // 2. Primitive stage over all draws, in chunks; results concatenated in order.
+    let mut primitive_jobs = Vec::new();
+    let orders: Vec<Option<Vec<u32>>> = draws
+        .par_iter()
+        .zip(shaded.par_iter())
+        .map(|(d, s)| d.sort_order(s))
+        .collect();
+    for (draw, d) in draws.iter().enumerate() {
+        let count = d.triangle_count();
+        let mut first = 0;
+        while first < count {
+            let last = (first + PRIMITIVE_CHUNK).min(count);
+            primitive_jobs.push((draw, first, last));
+            first = last;
+        }
+    }
+    let target = TargetSpace {
+        viewport: *viewport,
+        guard: GuardBand::new(viewport.width, viewport.height),
+    };
+    if batches.len() < primitive_jobs.len() {
+        batches.resize_with(primitive_jobs.len(), PrimitiveBatch::default);
+    }
+    let batches = &mut batches[..primitive_jobs.len()];
+    batches
+        .par_iter_mut()
+        .zip(primitive_jobs.par_iter())
+        .for_each(|(batch, &(draw, first, last))| {
+            batch.clear();
+            draws[draw].assemble(
+                draw as u32,
+                first..last,
+                orders[draw].as_deref(),
+                &shaded[draw],
+                &target,
+                batch,
+            );
+        });
+
+    output.triangles.clear();
+    output.attrs.clear();
+    output.draw_first.clear();
+    output.draw_first.resize(draws.len(), (0, 0));
+    output
+        .triangles
+        .reserve(batches.iter().map(|b| b.triangles.len()).sum());
+    output
+        .attrs
+        .reserve(batches.iter().map(|b| b.attrs.len()).sum());
+    let mut counters = PrimitiveCounters::default();
+    let mut next_draw = 0;
+    for batch in batches.iter() {
+        if let Some(first) = batch.triangles.first() {
+            // Record where each draw begins (draws with no triangles keep a harmless value).
+            while next_draw <= first.draw as usize {
+                output.draw_first[next_draw] = (output.triangles.len(), output.attrs.len());
+                next_draw += 1;
+            }
+        }
+        output.triangles.extend_from_slice(&batch.triangles);
+        output.attrs.extend_from_slice(&batch.attrs);
+        counters = PrimitiveCounters::sum(counters, batch.counters);
+    }
+    stats.triangles_in = counters.triangles_in;
+    stats.triangles_invalid = counters.invalid;
+    stats.triangles_rejected = counters.rejected;
+    stats.triangles_clipped = counters.clipped;
+    stats.triangles_culled = counters.culled;
+    stats.triangles_degenerate = counters.degenerate;
+}

@@ -1,0 +1,254 @@
+//! The programmable pipeline: shaders, render state, and the frame that runs the stages.
+//!
+//! ```text
+//! Frame::draw (queue, in order)
+//!   └─ end():
+//!      1. vertex stage      Shader::vertex on every vertex            (parallel over chunks)
+//!      2. primitive stage   assemble, reject, clip, cull, set up      (parallel over chunks,
+//!                           → TriangleSetup + varyings                  results kept in order)
+//!      3. binning           triangles → per-tile lists, in order      (serial, cheap)
+//!      4. raster            per tile: traverse, depth, Shader::fragment, blend
+//!                                                                      (parallel over tiles)
+//! ```
+//! Each tile is owned by one thread and processes its triangles in submission order, so the
+//! picture is identical for every thread count and traversal strategy.
+
+mod draw;
+mod fragment;
+mod geometry;
+mod shader;
+
+use std::time::Instant;
+
+use glam::Vec4;
+
+pub use self::draw::Indices;
+pub use self::shader::{FnShader, Fragment, FragmentLanes, ShadedLanes, Shader};
+pub use crate::state::RenderState;
+
+use self::draw::{DrawCall, DrawJob};
+use self::geometry::{run_geometry, GeometryScratch};
+use crate::error::RenderError;
+use crate::raster::bin::TileBins;
+use crate::raster::Strategy;
+use crate::rop::Framebuffer;
+use crate::setup::Viewport;
+use crate::simd::Isa;
+use crate::stats::FrameStats;
+use crate::{MAX_TARGET_SIZE, MAX_VARYINGS};
+
+/// Options of a [`Renderer`].
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RendererOptions {
+    /// Worker threads; `None` uses every core.
+    pub threads: Option<usize>,
+    /// Triangle traversal strategy.
+    pub strategy: Strategy,
+    /// Instruction set of the per-pixel path; `None` uses [`Isa::selected`] (the best the CPU
+    /// has, or `KANTELE_ISA`). Every choice gives the same picture, bit for bit.
+    pub isa: Option<Isa>,
+}
+
+/// The CPU renderer: owns the framebuffer and the worker threads.
+pub struct Renderer {
+    framebuffer: Framebuffer,
+    pool: rayon::ThreadPool,
+    strategy: Strategy,
+    isa: Isa,
+    bins: TileBins,
+    scratch: GeometryScratch,
+}
+
+impl Renderer {
+    /// A renderer with a `width × height` target (each side 1..=[`MAX_TARGET_SIZE`]).
+    pub fn new(width: u32, height: u32, options: RendererOptions) -> Result<Self, RenderError> {
+        check_target_size(width, height)?;
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(options.threads.unwrap_or(0))
+            .thread_name(|i| format!("kantele-worker-{i}"))
+            .build()
+            .map_err(|e| RenderError::Backend {
+                backend: "cpu".into(),
+                message: format!("cannot start worker threads: {e}"),
+            })?;
+        Ok(Self {
+            framebuffer: Framebuffer::new(width, height)?,
+            pool,
+            strategy: options.strategy,
+            isa: resolve_isa(options.isa),
+            bins: TileBins::default(),
+            scratch: GeometryScratch::default(),
+        })
+    }
+
+    /// Changes the target size (contents become undefined: clear before drawing).
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+        check_target_size(width, height)?;
+        if (width, height) != (self.framebuffer.width(), self.framebuffer.height()) {
+            self.framebuffer = Framebuffer::new(width, height)?;
+        }
+        Ok(())
+    }
+
+    /// The traversal strategy in use.
+    pub fn strategy(&self) -> Strategy {
+        self.strategy
+    }
+
+    /// Changes the traversal strategy (pictures stay identical).
+    pub fn set_strategy(&mut self, strategy: Strategy) {
+        self.strategy = strategy;
+    }
+
+    /// The instruction set of the per-pixel path.
+    pub fn isa(&self) -> Isa {
+        self.isa
+    }
+
+    /// Changes the instruction set of the per-pixel path (pictures stay identical); an
+    /// instruction set this CPU lacks falls back to scalar.
+    pub fn set_isa(&mut self, isa: Isa) {
+        self.isa = resolve_isa(Some(isa));
+    }
+
+    /// Number of worker threads.
+    pub fn threads(&self) -> usize {
+        self.pool.current_num_threads()
+    }
+
+    /// The colour and depth target.
+    pub fn framebuffer(&self) -> &Framebuffer {
+        &self.framebuffer
+    }
+
+    /// Starts a frame: optionally clears colour and depth, then collects draws until
+    /// [`Frame::end`].
+    pub fn begin_frame<'a>(
+        &mut self,
+        clear_color: Option<Vec4>,
+        clear_depth: Option<f32>,
+    ) -> Frame<'_, 'a> {
+        Frame {
+            renderer: self,
+            clear_color,
+            clear_depth,
+            draws: Vec::new(),
+        }
+    }
+}
+
+/// The instruction set to use: the requested one when the CPU has it, else the selected one.
+fn resolve_isa(requested: Option<Isa>) -> Isa {
+    match requested {
+        Some(isa) if isa.is_supported() => isa,
+        Some(_) => Isa::Scalar,
+        None => Isa::selected(),
+    }
+}
+
+fn check_target_size(width: u32, height: u32) -> Result<(), RenderError> {
+    if width == 0 || height == 0 || width > MAX_TARGET_SIZE || height > MAX_TARGET_SIZE {
+        return Err(RenderError::InvalidSize { width, height });
+    }
+    Ok(())
+}
+
+/// A frame being recorded: draws are queued in order and run by [`Frame::end`]. `'r` is the
+/// borrow of the renderer, `'a` that of the draws' shaders and buffers.
+pub struct Frame<'r, 'a> {
+    renderer: &'r mut Renderer,
+    clear_color: Option<Vec4>,
+    clear_depth: Option<f32>,
+    draws: Vec<Box<dyn DrawJob + 'a>>,
+}
+
+impl<'a> Frame<'_, 'a> {
+    /// Queues a draw of `indices` (or of the vertices in order) from `vertices` with `shader`
+    /// and `state`. Checks the buffers now; nothing is drawn until [`Frame::end`].
+    pub fn draw<S: Shader>(
+        &mut self,
+        shader: &'a S,
+        vertices: &'a [S::Vertex],
+        indices: Indices<'a>,
+        state: RenderState,
+    ) -> Result<(), RenderError> {
+        let n = shader.varying_count();
+        if n > MAX_VARYINGS {
+            return Err(RenderError::TooManyVaryings(n));
+        }
+        let count = indices.len(vertices.len());
+        if count % 3 != 0 {
+            return Err(RenderError::IncompleteTriangle(count));
+        }
+        let out_of_range = |ix: usize| ix >= vertices.len();
+        let bad = match indices {
+            Indices::None => None,
+            Indices::U16(ix) => ix.iter().position(|&i| out_of_range(i as usize)),
+            Indices::U32(ix) => ix.iter().position(|&i| out_of_range(i as usize)),
+        };
+        if let Some(position) = bad {
+            return Err(RenderError::IndexOutOfRange {
+                index: indices.get(position) as u32,
+                position,
+                vertex_count: vertices.len(),
+            });
+        }
+        self.draws.push(Box::new(DrawCall {
+            shader,
+            vertices,
+            indices,
+            state,
+        }));
+        Ok(())
+    }
+
+    /// Runs every queued draw and returns what each stage did.
+    pub fn end(self) -> FrameStats {
+        let Frame {
+            renderer,
+            clear_color,
+            clear_depth,
+            draws,
+        } = self;
+        let start = Instant::now();
+        let mut stats = FrameStats {
+            draws: draws.len() as u64,
+            ..FrameStats::default()
+        };
+        let Renderer {
+            framebuffer,
+            pool,
+            strategy,
+            isa,
+            bins,
+            scratch,
+        } = renderer;
+        let (strategy, isa) = (*strategy, *isa);
+        pool.install(|| {
+            framebuffer.clear(clear_color, clear_depth);
+            let viewport = Viewport::new(framebuffer.width(), framebuffer.height());
+            let geometry_start = Instant::now();
+            run_geometry(&draws, &viewport, &mut stats, scratch);
+            let geometry = &scratch.output;
+            stats.geometry_time = geometry_start.elapsed();
+
+            let binning_start = Instant::now();
+            let grid = *framebuffer.grid();
+            stats.bin_entries = bins.bin_triangles(&grid, &geometry.triangles);
+            stats.triangles_binned = geometry.triangles.len() as u64;
+            stats.binning_time = binning_start.elapsed();
+
+            let raster_start = Instant::now();
+            let counters =
+                fragment::raster_tiles(framebuffer, bins, geometry, &draws, strategy, isa);
+            stats.fragments_covered = counters.covered;
+            stats.tiles_depth_rejected = counters.tile_rejected;
+            stats.blocks_depth_rejected = counters.blocks_rejected;
+            stats.fragments_shaded = counters.shaded;
+            stats.fragments_discarded = counters.discarded;
+            stats.raster_time = raster_start.elapsed();
+        });
+        stats.total_time = start.elapsed();
+        stats
+    }
+}

@@ -1,0 +1,460 @@
+//! The AVX2 implementation: one 256-bit register per value.
+//!
+//! Every method is `#[inline(always)]` and calls the intrinsics inside `unsafe` blocks whose
+//! justification is the same: a value of these types exists only if an [`Avx2`] token was made,
+//! and [`Avx2::new`] makes one only after detecting AVX2 at run time. The `fma` feature is never
+//! enabled, so a multiply followed by an add stays two instructions (two roundings).
+
+use std::arch::x86_64::*;
+use std::fmt;
+use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Sub};
+
+use super::{F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
+
+/// The AVX2 implementation's token: proof that this CPU runs AVX2.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Avx2 {
+    _detected: (),
+}
+
+impl Avx2 {
+    /// The token, if this CPU supports AVX2 (runtime detection, cached by `std`).
+    #[inline(always)]
+    pub fn new() -> Option<Avx2> {
+        if is_x86_feature_detected!("avx2") {
+            Some(Avx2 { _detected: () })
+        } else {
+            None
+        }
+    }
+}
+
+/// Runs `kernel` compiled for AVX2: the kernel and the lane methods, all `#[inline(always)]`,
+/// are inlined into this `#[target_feature]` function.
+#[inline]
+pub(super) fn run<K: LaneKernel>(token: Avx2, kernel: K) -> K::Output {
+    #[target_feature(enable = "avx2")]
+    unsafe fn run_avx2<K: LaneKernel>(token: Avx2, kernel: K) -> K::Output {
+        kernel.run(token)
+    }
+    // SAFETY: `token` exists, so AVX2 was detected on this CPU.
+    unsafe { run_avx2(token, kernel) }
+}
+
+/// 8 × `f32` in a `__m256`.
+#[derive(Clone, Copy)]
+pub struct Avx2F32(__m256);
+
+/// 8 × `i32` in a `__m256i`.
+#[derive(Clone, Copy)]
+pub struct Avx2I32(__m256i);
+
+/// 8 lane booleans as all-ones / all-zeros 32-bit lanes of a `__m256`.
+#[derive(Clone, Copy)]
+pub struct Avx2Mask(__m256);
+
+/// Wraps intrinsic calls that need AVX/AVX2: sound because a token or a lane value exists.
+macro_rules! avx {
+    ($($body:tt)*) => {
+        // SAFETY: AVX2 (which implies AVX) was detected before any `Avx2` token, and therefore
+        // any value of this module, could be made; pointer arguments are checked by the caller.
+        unsafe { $($body)* }
+    };
+}
+
+impl fmt::Debug for Avx2F32 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_tuple("Avx2F32").field(&self.to_array()).finish()
+    }
+}
+
+impl fmt::Debug for Avx2I32 {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_tuple("Avx2I32").field(&self.to_array()).finish()
+    }
+}
+
+impl fmt::Debug for Avx2Mask {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "Avx2Mask({:#010b})", self.bits())
+    }
+}
+
+impl Lanes for Avx2 {
+    type F32 = Avx2F32;
+    type I32 = Avx2I32;
+    type Mask = Avx2Mask;
+
+    #[inline(always)]
+    fn isa(self) -> Isa {
+        Isa::Avx2
+    }
+    #[inline(always)]
+    fn splat_f32(self, v: f32) -> Avx2F32 {
+        avx!(Avx2F32(_mm256_set1_ps(v)))
+    }
+    #[inline(always)]
+    fn f32_from_array(self, a: [f32; 8]) -> Avx2F32 {
+        // The pointer is to 8 readable f32.
+        avx!(Avx2F32(_mm256_loadu_ps(a.as_ptr())))
+    }
+    #[inline(always)]
+    fn load_f32(self, s: &[f32]) -> Avx2F32 {
+        let s = &s[..8];
+        avx!(Avx2F32(_mm256_loadu_ps(s.as_ptr())))
+    }
+    #[inline(always)]
+    fn splat_i32(self, v: i32) -> Avx2I32 {
+        avx!(Avx2I32(_mm256_set1_epi32(v)))
+    }
+    #[inline(always)]
+    fn i32_from_array(self, a: [i32; 8]) -> Avx2I32 {
+        avx!(Avx2I32(_mm256_loadu_si256(a.as_ptr().cast())))
+    }
+    #[inline(always)]
+    fn load_i32(self, s: &[i32]) -> Avx2I32 {
+        let s = &s[..8];
+        avx!(Avx2I32(_mm256_loadu_si256(s.as_ptr().cast())))
+    }
+    #[inline(always)]
+    fn lane_index(self) -> Avx2I32 {
+        avx!(Avx2I32(_mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7)))
+    }
+    #[inline(always)]
+    fn mask_from_bits(self, bits: u8) -> Avx2Mask {
+        avx!({
+            let lane_bits = _mm256_setr_epi32(1, 2, 4, 8, 16, 32, 64, 128);
+            let selected = _mm256_and_si256(_mm256_set1_epi32(i32::from(bits)), lane_bits);
+            Avx2Mask(_mm256_castsi256_ps(_mm256_cmpeq_epi32(selected, lane_bits)))
+        })
+    }
+    #[inline(always)]
+    fn mask_all(self, value: bool) -> Avx2Mask {
+        avx!(Avx2Mask(_mm256_castsi256_ps(_mm256_set1_epi32(
+            -i32::from(value)
+        ))))
+    }
+}
+
+macro_rules! binary_ops {
+    ($ty:ident, $($trait:ident $method:ident $intrinsic:ident;)*) => {$(
+        impl $trait for $ty {
+            type Output = $ty;
+            #[inline(always)]
+            fn $method(self, other: $ty) -> $ty {
+                avx!($ty($intrinsic(self.0, other.0)))
+            }
+        }
+    )*};
+}
+
+binary_ops!(Avx2F32,
+    Add add _mm256_add_ps;
+    Sub sub _mm256_sub_ps;
+    Mul mul _mm256_mul_ps;
+    Div div _mm256_div_ps;
+);
+
+binary_ops!(Avx2I32,
+    Add add _mm256_add_epi32;
+    Sub sub _mm256_sub_epi32;
+    Mul mul _mm256_mullo_epi32;
+    BitAnd bitand _mm256_and_si256;
+    BitOr bitor _mm256_or_si256;
+    BitXor bitxor _mm256_xor_si256;
+);
+
+impl Neg for Avx2F32 {
+    type Output = Avx2F32;
+    #[inline(always)]
+    fn neg(self) -> Avx2F32 {
+        avx!(Avx2F32(_mm256_xor_ps(self.0, _mm256_set1_ps(-0.0))))
+    }
+}
+
+impl Not for Avx2I32 {
+    type Output = Avx2I32;
+    #[inline(always)]
+    fn not(self) -> Avx2I32 {
+        avx!(Avx2I32(_mm256_xor_si256(self.0, _mm256_set1_epi32(-1))))
+    }
+}
+
+impl Avx2F32 {
+    #[inline(always)]
+    fn compare<const PREDICATE: i32>(self, other: Self) -> Avx2Mask {
+        avx!(Avx2Mask(_mm256_cmp_ps::<PREDICATE>(self.0, other.0)))
+    }
+}
+
+/// Reduces the 8 lanes of a `__m256` with the 128-bit operation `$op` in the shared tree
+/// order: `(k, k + 4)`, then `(k, k + 2)`, then `(0, 1)`.
+macro_rules! reduce {
+    ($v:expr, $op:ident) => {
+        avx!({
+            let halves = $op(_mm256_castps256_ps128($v), _mm256_extractf128_ps::<1>($v));
+            let pairs = $op(halves, _mm_movehl_ps(halves, halves));
+            _mm_cvtss_f32($op(pairs, _mm_shuffle_ps::<0b01>(pairs, pairs)))
+        })
+    };
+}
+
+impl F32x8 for Avx2F32 {
+    type Lanes = Avx2;
+
+    #[inline(always)]
+    fn lanes(self) -> Avx2 {
+        Avx2 { _detected: () }
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        avx!(Avx2F32(_mm256_min_ps(self.0, other.0)))
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        avx!(Avx2F32(_mm256_max_ps(self.0, other.0)))
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        avx!(Avx2F32(_mm256_sqrt_ps(self.0)))
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        avx!(Avx2F32(_mm256_andnot_ps(_mm256_set1_ps(-0.0), self.0)))
+    }
+    #[inline(always)]
+    fn floor(self) -> Self {
+        avx!(Avx2F32(_mm256_round_ps::<
+            { _MM_FROUND_TO_NEG_INF | _MM_FROUND_NO_EXC },
+        >(self.0)))
+    }
+    #[inline(always)]
+    fn round_ties_even(self) -> Self {
+        avx!(Avx2F32(_mm256_round_ps::<
+            { _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC },
+        >(self.0)))
+    }
+    #[inline(always)]
+    fn simd_lt(self, other: Self) -> Avx2Mask {
+        self.compare::<_CMP_LT_OQ>(other)
+    }
+    #[inline(always)]
+    fn simd_le(self, other: Self) -> Avx2Mask {
+        self.compare::<_CMP_LE_OQ>(other)
+    }
+    #[inline(always)]
+    fn simd_gt(self, other: Self) -> Avx2Mask {
+        self.compare::<_CMP_GT_OQ>(other)
+    }
+    #[inline(always)]
+    fn simd_ge(self, other: Self) -> Avx2Mask {
+        self.compare::<_CMP_GE_OQ>(other)
+    }
+    #[inline(always)]
+    fn simd_eq(self, other: Self) -> Avx2Mask {
+        self.compare::<_CMP_EQ_OQ>(other)
+    }
+    #[inline(always)]
+    fn simd_ne(self, other: Self) -> Avx2Mask {
+        self.compare::<_CMP_NEQ_UQ>(other)
+    }
+    #[inline(always)]
+    fn to_array(self) -> [f32; 8] {
+        let mut out = [0.0; 8];
+        // The pointer is to 8 writable f32.
+        avx!(_mm256_storeu_ps(out.as_mut_ptr(), self.0));
+        out
+    }
+    #[inline(always)]
+    fn store(self, out: &mut [f32]) {
+        let out = &mut out[..8];
+        avx!(_mm256_storeu_ps(out.as_mut_ptr(), self.0));
+    }
+    #[inline(always)]
+    fn store_masked(self, mask: Avx2Mask, out: &mut [f32]) {
+        let out = &mut out[..8];
+        avx!({
+            let old = _mm256_loadu_ps(out.as_ptr());
+            _mm256_storeu_ps(out.as_mut_ptr(), _mm256_blendv_ps(old, self.0, mask.0));
+        });
+    }
+    #[inline(always)]
+    fn to_i32_trunc(self) -> Avx2I32 {
+        avx!(Avx2I32(_mm256_cvttps_epi32(self.0)))
+    }
+    #[inline(always)]
+    fn to_i32_floor(self) -> Avx2I32 {
+        self.floor().to_i32_trunc()
+    }
+    #[inline(always)]
+    fn to_bits(self) -> Avx2I32 {
+        avx!(Avx2I32(_mm256_castps_si256(self.0)))
+    }
+    #[inline(always)]
+    fn from_bits(bits: Avx2I32) -> Self {
+        avx!(Avx2F32(_mm256_castsi256_ps(bits.0)))
+    }
+    #[inline(always)]
+    fn extract(self, k: usize) -> f32 {
+        self.to_array()[k]
+    }
+    #[inline(always)]
+    fn reduce_min(self) -> f32 {
+        reduce!(self.0, _mm_min_ps)
+    }
+    #[inline(always)]
+    fn reduce_max(self) -> f32 {
+        reduce!(self.0, _mm_max_ps)
+    }
+}
+
+impl I32x8 for Avx2I32 {
+    type Lanes = Avx2;
+
+    #[inline(always)]
+    fn lanes(self) -> Avx2 {
+        Avx2 { _detected: () }
+    }
+    #[inline(always)]
+    fn shl<const N: i32>(self) -> Self {
+        const { assert!(N >= 0 && N < 32, "shift count must be in 0..32") };
+        avx!(Avx2I32(_mm256_slli_epi32::<N>(self.0)))
+    }
+    #[inline(always)]
+    fn shr_arith<const N: i32>(self) -> Self {
+        const { assert!(N >= 0 && N < 32, "shift count must be in 0..32") };
+        avx!(Avx2I32(_mm256_srai_epi32::<N>(self.0)))
+    }
+    #[inline(always)]
+    fn shr_logical<const N: i32>(self) -> Self {
+        const { assert!(N >= 0 && N < 32, "shift count must be in 0..32") };
+        avx!(Avx2I32(_mm256_srli_epi32::<N>(self.0)))
+    }
+    #[inline(always)]
+    fn min(self, other: Self) -> Self {
+        avx!(Avx2I32(_mm256_min_epi32(self.0, other.0)))
+    }
+    #[inline(always)]
+    fn max(self, other: Self) -> Self {
+        avx!(Avx2I32(_mm256_max_epi32(self.0, other.0)))
+    }
+    #[inline(always)]
+    fn simd_eq(self, other: Self) -> Avx2Mask {
+        avx!(Avx2Mask(_mm256_castsi256_ps(_mm256_cmpeq_epi32(
+            self.0, other.0
+        ))))
+    }
+    #[inline(always)]
+    fn simd_gt(self, other: Self) -> Avx2Mask {
+        avx!(Avx2Mask(_mm256_castsi256_ps(_mm256_cmpgt_epi32(
+            self.0, other.0
+        ))))
+    }
+    #[inline(always)]
+    fn simd_lt(self, other: Self) -> Avx2Mask {
+        other.simd_gt(self)
+    }
+    #[inline(always)]
+    fn to_f32(self) -> Avx2F32 {
+        avx!(Avx2F32(_mm256_cvtepi32_ps(self.0)))
+    }
+    #[inline(always)]
+    fn to_array(self) -> [i32; 8] {
+        let mut out = [0; 8];
+        avx!(_mm256_storeu_si256(out.as_mut_ptr().cast(), self.0));
+        out
+    }
+    #[inline(always)]
+    fn store(self, out: &mut [i32]) {
+        let out = &mut out[..8];
+        avx!(_mm256_storeu_si256(out.as_mut_ptr().cast(), self.0));
+    }
+    #[inline(always)]
+    fn gather_u32(self, table: &[u32]) -> Self {
+        let Some(last) = table.len().checked_sub(1) else {
+            return avx!(Avx2I32(_mm256_setzero_si256()));
+        };
+        let last = i32::try_from(last).unwrap_or(i32::MAX);
+        // Every clamped index is in `0..table.len()`, so every 4-byte read is inside `table`.
+        avx!({
+            let index = _mm256_min_epi32(
+                _mm256_max_epi32(self.0, _mm256_setzero_si256()),
+                _mm256_set1_epi32(last),
+            );
+            Avx2I32(_mm256_i32gather_epi32::<4>(table.as_ptr().cast(), index))
+        })
+    }
+    #[inline(always)]
+    fn extract(self, k: usize) -> i32 {
+        self.to_array()[k]
+    }
+    #[inline(always)]
+    fn sign_bits(self) -> u8 {
+        avx!(_mm256_movemask_ps(_mm256_castsi256_ps(self.0)) as u8)
+    }
+}
+
+impl Mask8 for Avx2Mask {
+    type Lanes = Avx2;
+
+    #[inline(always)]
+    fn lanes(self) -> Avx2 {
+        Avx2 { _detected: () }
+    }
+    #[inline(always)]
+    fn and(self, other: Self) -> Self {
+        avx!(Avx2Mask(_mm256_and_ps(self.0, other.0)))
+    }
+    #[inline(always)]
+    fn or(self, other: Self) -> Self {
+        avx!(Avx2Mask(_mm256_or_ps(self.0, other.0)))
+    }
+    #[inline(always)]
+    fn xor(self, other: Self) -> Self {
+        avx!(Avx2Mask(_mm256_xor_ps(self.0, other.0)))
+    }
+    #[inline(always)]
+    fn not(self) -> Self {
+        avx!(Avx2Mask(_mm256_xor_ps(
+            self.0,
+            _mm256_castsi256_ps(_mm256_set1_epi32(-1))
+        )))
+    }
+    #[inline(always)]
+    fn and_not(self, other: Self) -> Self {
+        // `andnot(a, b)` is `!a & b`.
+        avx!(Avx2Mask(_mm256_andnot_ps(other.0, self.0)))
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self.bits() != 0
+    }
+    #[inline(always)]
+    fn all(self) -> bool {
+        self.bits() == 0xff
+    }
+    #[inline(always)]
+    fn none(self) -> bool {
+        self.bits() == 0
+    }
+    #[inline(always)]
+    fn bits(self) -> u8 {
+        avx!(_mm256_movemask_ps(self.0) as u8)
+    }
+    #[inline(always)]
+    fn count(self) -> u32 {
+        self.bits().count_ones()
+    }
+    #[inline(always)]
+    fn select_f32(self, if_true: Avx2F32, if_false: Avx2F32) -> Avx2F32 {
+        avx!(Avx2F32(_mm256_blendv_ps(if_false.0, if_true.0, self.0)))
+    }
+    #[inline(always)]
+    fn select_i32(self, if_true: Avx2I32, if_false: Avx2I32) -> Avx2I32 {
+        avx!(Avx2I32(_mm256_castps_si256(_mm256_blendv_ps(
+            _mm256_castsi256_ps(if_false.0),
+            _mm256_castsi256_ps(if_true.0),
+            self.0
+        ))))
+    }
+}
