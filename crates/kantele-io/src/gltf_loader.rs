@@ -62,6 +62,10 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     };
     let (json, blob) = split_glb(&bytes).map_err(invalid)?;
     drop(bytes);
+    // A parsed JSON tree takes several times its text.
+    budget
+        .charge(json.len() as u64, 16, "parsing the glTF JSON")
+        .map_err(invalid)?;
     let mut value: serde_json::Value = serde_json::from_slice(&json)
         .map_err(|e| invalid(format!("not a valid glTF file: {e}")))?;
     drop(json);
@@ -1027,6 +1031,10 @@ impl Loader<'_> {
             material,
         };
         if converted.normals.is_none() {
+            // De-indexed: one vertex (position, normal, texcoord, colour) per corner.
+            self.budget
+                .charge(converted.indices.len() as u64, 48, &what)
+                .map_err(|e| self.invalid(e))?;
             flat_normals(&mut converted);
         }
         self.scene.meshes.push(converted);
