@@ -165,3 +165,25 @@ fn quantized_attributes_of_every_allowed_type() {
         loaded.info.warnings
     );
 }
+
+#[test]
+fn webp_textures_decode() {
+    // A 2 × 2 lossless WebP (red, green / blue, white), shown through EXT_texture_webp with a
+    // PNG fallback of another colour: the WebP must win.
+    let rgba = [
+        255u8, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255,
+    ];
+    let image = image::RgbaImage::from_raw(2, 2, rgba.to_vec()).unwrap();
+    let mut webp = std::io::Cursor::new(Vec::new());
+    image.write_to(&mut webp, image::ImageFormat::WebP).unwrap();
+    let mut g = textured_quad();
+    g.images[0] = png(1, 1, &[0, 0, 0, 255]);
+    let webp_image = g.image(webp.into_inner());
+    g.json["images"][webp_image]["mimeType"] = json!("image/webp");
+    g.json["textures"][0]["extensions"] = json!({"EXT_texture_webp": {"source": webp_image}});
+    g.json["extensionsUsed"] = json!(["EXT_texture_webp", "KHR_lights_punctual"]);
+    let loaded = load_scene(&write(&g, "webp")).expect("webp texture");
+    let texture = &loaded.scene.textures[0];
+    assert_eq!((texture.width(), texture.height()), (2, 2));
+    assert_eq!(texture.levels()[0].texels[1], Vec4::new(0.0, 1.0, 0.0, 1.0));
+}
