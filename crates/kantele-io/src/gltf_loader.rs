@@ -30,6 +30,7 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "EXT_mesh_gpu_instancing",
     "EXT_texture_webp",
+    "EXT_meshopt_compression",
 ];
 
 /// Extensions that change how geometry or images are stored and that this loader cannot decode:
@@ -81,7 +82,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     let document = check_extensions(path, root, &mut info)?;
     let policy = ReadPolicy::new(path, &options.allow_read);
     let buffers = load_buffers(path, &document, blob, &policy, &mut budget)?;
-    let decoded_views = HashMap::new();
+    let decoded_views = crate::meshopt_views::decode_views(&document, &buffers, &mut budget)
+        .map_err(|e| LoadError::invalid(path, e))?;
     Loader {
         path,
         document: &document,
