@@ -58,12 +58,12 @@ impl Texture {
         let lod = self.lod_lanes::<L>(duv_dx, duv_dy);
         let selection = LevelSelection::<L>::new(self, sampler, lod);
         let nearest = selection.nearest;
-        let first = self.sample_level_lanes::<L>(sampler, selection.first, uv, nearest);
+        let first = self.sample_level_lanes::<L>(sampler, selection.first, uv, nearest, live);
         // The second level only where some live lane blends (trilinear between levels).
         let blend = selection.fraction.simd_gt(zero).and(live);
         let mut texel = first;
         if blend.any() {
-            let second = self.sample_level_lanes::<L>(sampler, selection.second, uv, nearest);
+            let second = self.sample_level_lanes::<L>(sampler, selection.second, uv, nearest, live);
             // A lane with fraction 0 keeps `first` exactly: a·1 + b·0 = a for finite b ≥ 0.
             let keep = lanes.splat_f32(1.0) - selection.fraction;
             for c in 0..4 {
@@ -110,7 +110,8 @@ impl Texture {
     }
 
     /// Filters one level per lane (`level` holds each lane's level index) at `uv`, nearest where
-    /// `nearest` is set and bilinear elsewhere. Returns [`Channels`].
+    /// `nearest` is set and bilinear elsewhere; lanes outside `live` are unspecified. Returns
+    /// [`Channels`].
     #[inline(always)]
     fn sample_level_lanes<L: Lanes>(
         &self,
@@ -118,11 +119,10 @@ impl Texture {
         level: L::I32,
         uv: [L::F32; 2],
         nearest: MaskOf<L>,
+        live: MaskOf<L>,
     ) -> Channels<L> {
         let lanes = nearest.lanes();
-        let offset = level.gather_u32(&self.levels.offsets);
-        let width = level.gather_u32(&self.levels.widths);
-        let height = level.gather_u32(&self.levels.heights);
+        let (offset, width, height) = self.level_extents::<L>(level, live);
         let s = LaneAxis::<L>::new(sampler.wrap_s, uv[0], width);
         let t = LaneAxis::<L>::new(sampler.wrap_t, uv[1], height);
         if nearest.all() {
@@ -158,6 +158,32 @@ impl Texture {
             let bottom = t01[c] * one_alpha + t11[c] * alpha;
             top * one_beta + bottom * beta
         })
+    }
+
+    /// Each lane's level offset, width and height from the level table: one splat when every
+    /// `live` lane reads the same level (the common case), else gathered per lane.
+    #[inline(always)]
+    fn level_extents<L: Lanes>(&self, level: L::I32, live: MaskOf<L>) -> (L::I32, L::I32, L::I32) {
+        let lanes = live.lanes();
+        let first_live = (live.bits().trailing_zeros() as usize).min(7);
+        let first_level = level.extract(first_live);
+        let same = level
+            .simd_eq(lanes.splat_i32(first_level))
+            .or(live.not())
+            .all();
+        let table = &self.levels;
+        match usize::try_from(first_level) {
+            Ok(index) if same && index < table.offsets.len() => (
+                lanes.splat_i32(table.offsets[index] as i32),
+                lanes.splat_i32(table.widths[index] as i32),
+                lanes.splat_i32(table.heights[index] as i32),
+            ),
+            _ => (
+                level.gather_u32(&table.offsets),
+                level.gather_u32(&table.widths),
+                level.gather_u32(&table.heights),
+            ),
+        }
     }
 
     /// Gathers the texels at `index` and unpacks them: red, green and blue decoded through the
@@ -446,6 +472,12 @@ mod tests {
                     let scale = 2f32.powf(rng.range(-12.0, 2.0));
                     duv_dx[k] = Vec2::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * scale;
                     duv_dy[k] = Vec2::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * scale;
+                }
+                // Half the rows share one footprint (one level for all lanes, as in a typical
+                // row of pixels), half have one per lane.
+                if rng.next() % 2 == 0 {
+                    duv_dx = [duv_dx[0]; 8];
+                    duv_dy = [duv_dy[0]; 8];
                 }
                 Query {
                     uv,
