@@ -286,7 +286,11 @@ impl MaterialShader<'_> {
     fn base_color_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 4] {
         let lanes = f.lanes;
         let factor = self.material.base_color_factor.to_array();
-        let mut base = [0, 1, 2, 3].map(|c| lanes.splat_f32(factor[c]) * f.varying(5 + c));
+        // Loops, not closures: closures would call the lane operations out of line.
+        let mut base = [lanes.splat_f32(0.0); 4];
+        for c in 0..4 {
+            base[c] = lanes.splat_f32(factor[c]) * f.varying(5 + c);
+        }
         if let Some((texture, sampler)) = self.texture {
             let (du_dx, du_dy) = f.derivatives(3);
             let (dv_dx, dv_dy) = f.derivatives(4);

@@ -79,7 +79,10 @@ impl Texture {
         for c in raw_channels {
             texel[c] = texel[c] / scale;
         }
-        texel.map(|channel| live.select_f32(channel, zero))
+        for channel in &mut texel {
+            *channel = live.select_f32(*channel, zero);
+        }
+        texel
     }
 
     /// Per-lane level of detail `λ = ½ log2 ρ²` ([`Texture::lod`]): `−∞` where the footprint is
@@ -89,11 +92,10 @@ impl Texture {
         let lanes = duv_dx[0].lanes();
         let width = lanes.splat_f32(self.width() as f32);
         let height = lanes.splat_f32(self.height() as f32);
-        let length2 = |d: [L::F32; 2]| {
-            let (x, y) = (d[0] * width, d[1] * height);
-            x * x + y * y
-        };
-        let (rx, ry) = (length2(duv_dx), length2(duv_dy));
+        let (rx, ry) = (
+            footprint2::<L>(duv_dx, width, height),
+            footprint2::<L>(duv_dy, width, height),
+        );
         // `f32::max` ignores a NaN operand; the lane `max` returns `ry` when either is NaN.
         let ry_is_nan = ry.simd_ne(ry);
         let rho2 = ry_is_nan.select_f32(rx, rx.max(ry));
@@ -153,11 +155,15 @@ impl Texture {
         let t01 = self.fetch_lanes::<L>(row1 + x0);
         let t11 = self.fetch_lanes::<L>(row1 + x1);
         let (one_alpha, one_beta) = (lanes.splat_f32(1.0) - alpha, lanes.splat_f32(1.0) - beta);
-        std::array::from_fn(|c| {
+        // Plain loops, not closures: a closure would be compiled without the instruction set's
+        // target feature and call the lane operations out of line.
+        let mut texel = t00;
+        for c in 0..4 {
             let top = t00[c] * one_alpha + t10[c] * alpha;
             let bottom = t01[c] * one_alpha + t11[c] * alpha;
-            top * one_beta + bottom * beta
-        })
+            texel[c] = top * one_beta + bottom * beta;
+        }
+        texel
     }
 
     /// Each lane's level offset, width and height from the level table: one splat when every
@@ -200,8 +206,12 @@ impl Texture {
         match self.color_space {
             ColorSpace::Srgb => {
                 let table = decode_table(ColorSpace::Srgb);
-                let decode = |c: L::I32| L::F32::from_bits(c.gather_u32(table));
-                [decode(r), decode(g), decode(b), a]
+                [
+                    L::F32::from_bits(r.gather_u32(table)),
+                    L::F32::from_bits(g.gather_u32(table)),
+                    L::F32::from_bits(b.gather_u32(table)),
+                    a,
+                ]
             }
             ColorSpace::Linear => [r.to_f32(), g.to_f32(), b.to_f32(), a],
         }
@@ -320,6 +330,13 @@ impl Wrap {
     }
 }
 
+/// `x² + y²` of a derivative `[∂u, ∂v]` scaled to texels (`width`, `height`).
+#[inline(always)]
+fn footprint2<L: Lanes>(d: [L::F32; 2], width: L::F32, height: L::F32) -> L::F32 {
+    let (x, y) = (d[0] * width, d[1] * height);
+    x * x + y * y
+}
+
 /// `log2 x` for positive normal `x`, from the exponent bits and a polynomial in
 /// `s = (m − 1)/(m + 1)` with the mantissa `m` in `[√½, √2)`: `log2 m = (2/ln 2)·atanh s`, the
 /// series to `s⁹` (truncation below 2e-9 for `|s| ≤ 0.172`). Other inputs give unspecified values.
@@ -346,8 +363,13 @@ pub(super) fn log2_normal<L: Lanes>(x: L::F32) -> L::F32 {
         TWO_LOG2_E / 7.0,
         TWO_LOG2_E / 9.0,
     ];
-    let c = |k: usize| lanes.splat_f32(C[k]);
-    let poly = c(0) + s2 * (c(1) + s2 * (c(2) + s2 * (c(3) + s2 * c(4))));
+    let (c1, c3, c5) = (
+        lanes.splat_f32(C[0]),
+        lanes.splat_f32(C[1]),
+        lanes.splat_f32(C[2]),
+    );
+    let (c7, c9) = (lanes.splat_f32(C[3]), lanes.splat_f32(C[4]));
+    let poly = c1 + s2 * (c3 + s2 * (c5 + s2 * (c7 + s2 * c9)));
     exponent.to_f32() + s * poly
 }
 
