@@ -27,8 +27,8 @@ impl Texture {
     /// [`Texture::sample_grad`] does for one.
     ///
     /// `uv`, `duv_dx` and `duv_dy` hold `[u, v]`, `[∂u/∂x, ∂v/∂x]` and `[∂u/∂y, ∂v/∂y]` as
-    /// lanes. Returns linear `[r, g, b, a]` lanes. Lanes outside `active` are not sampled and
-    /// hold unspecified (finite or not) values; a lane with a NaN or infinite coordinate gives 0.
+    /// lanes. Returns linear `[r, g, b, a]` lanes. Lanes outside `active` are not sampled, and
+    /// they and lanes with a NaN or infinite coordinate give 0 (as [`Texture::sample_lod`]).
     #[inline(always)]
     pub fn sample_grad_lanes<L: Lanes>(
         &self,
