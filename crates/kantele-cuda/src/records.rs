@@ -344,7 +344,7 @@ impl SceneArrays {
         for texture in &scene.textures {
             out.textures.push(TextureRecord {
                 first_level: out.levels.len() as u32,
-                level_count: texture.levels().len() as u32,
+                level_count: texture.level_count() as u32,
                 width: texture.width(),
                 height: texture.height(),
             });
@@ -354,7 +354,12 @@ impl SceneArrays {
                     width: level.width,
                     height: level.height,
                 });
-                out.texels.extend(level.texels.iter().map(|t| t.to_array()));
+                // The GPU filters linear f32 texels: the 8-bit levels decoded once, at upload.
+                for y in 0..level.height {
+                    for x in 0..level.width {
+                        out.texels.push(level.texel(x, y).to_array());
+                    }
+                }
             }
         }
         let (mut shaded, mut slots) = (0u64, 0u64);

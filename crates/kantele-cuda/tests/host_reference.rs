@@ -452,13 +452,16 @@ fn kernel_texture_sampling_matches_the_core_bit_for_bit() {
             1 => rng.range(0.0, 1.0),
             _ => rng.range(0.0, 5.0),
         };
-        input.push_str(&format!("X {}", texture.levels().len()));
+        input.push_str(&format!("X {}", texture.level_count()));
         for level in texture.levels() {
             input.push_str(&format!(" {} {}", level.width, level.height));
-            for t in &level.texels {
-                for v in t.to_array() {
-                    input.push(' ');
-                    input.push_str(&hex(v));
+            // The linear f32 texels the GPU is given (the 8-bit levels decoded at upload).
+            for y in 0..level.height {
+                for x in 0..level.width {
+                    for v in level.texel(x, y).to_array() {
+                        input.push(' ');
+                        input.push_str(&hex(v));
+                    }
                 }
             }
         }

@@ -37,7 +37,8 @@
 //! - **Depth.** `GL_DEPTH_COMPONENT32F`, cleared to 1, test `GL_LESS`, default depth range, so
 //!   window depth = `(z/w + 1) / 2`.
 //! - **Textures.** Every level of kantele's mip chain ([`Texture::levels`]) is uploaded as
-//!   `GL_RGBA32F`, so both renderers filter identical linear texel values. Rows go up in memory
+//!   its 8-bit texels, `GL_SRGB8_ALPHA8` for sRGB textures and `GL_RGBA8` otherwise, so both
+//!   renderers decode and filter identical texels. Rows go up in memory
 //!   order: the image's top row is GL's `t = 0` row, which is where glTF's `v = 0` points. One
 //!   sampler object per textured material carries the glTF wrap modes and filters.
 //! - **Meshes without normals** are split into one vertex triple per triangle carrying the

@@ -63,7 +63,7 @@ uniform vec2 u_ids;            // node index + 1, draw index + 1
 layout(location = 0) out vec4 o_color;
 
 void main() {
-    // Texels are RGBA32F holding the already-decoded linear values of kantele's mip chain.
+    // Texels are kantele's 8-bit mip chain (SRGB8_ALPHA8 or RGBA8), decoded to linear by GL.
     vec4 base = u_base_color_factor * v_color;
     if (u_has_texture) {
         base *= texture(u_base_color_texture, v_texcoord);

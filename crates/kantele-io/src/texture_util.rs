@@ -135,11 +135,11 @@ mod tests {
         let t = checker(256, 8, [255, 255, 255], [0, 0, 0]);
         assert_eq!((t.width(), t.height()), (256, 256));
         assert_eq!(t.levels().len(), 9);
-        let level = &t.levels()[0];
-        assert_eq!(level.texels[0].x, 1.0);
-        assert_eq!(level.texels[32].x, 0.0);
-        assert_eq!(level.texels[32 * 256].x, 0.0);
-        assert_eq!(level.texels[32 * 256 + 32].x, 1.0);
+        let level = t.level(0).expect("level 0");
+        assert_eq!(level.texel(0, 0).x, 1.0);
+        assert_eq!(level.texel(32, 0).x, 0.0);
+        assert_eq!(level.texel(0, 32).x, 0.0);
+        assert_eq!(level.texel(32, 32).x, 1.0);
     }
 
     #[test]

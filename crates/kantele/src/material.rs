@@ -314,7 +314,7 @@ impl MaterialShader<'_> {
         }
     }
 
-    /// [`MaterialShader::emissive`] per lane; the texture is sampled lane by lane.
+    /// [`MaterialShader::emissive`] per lane, the texture sampled lane-wide.
     #[inline(always)]
     fn emissive_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 3] {
         let lanes = f.lanes;
@@ -325,35 +325,23 @@ impl MaterialShader<'_> {
             lanes.splat_f32(e.z),
         ];
         if let Some((texture, sampler)) = self.emissive_texture {
-            let (u, v) = (f.varying(3).to_array(), f.varying(4).to_array());
             let (du_dx, du_dy) = f.derivatives(3);
             let (dv_dx, dv_dy) = f.derivatives(4);
-            let (du_dx, du_dy) = (du_dx.to_array(), du_dy.to_array());
-            let (dv_dx, dv_dy) = (dv_dx.to_array(), dv_dy.to_array());
-            let active = f.active.bits();
-            let mut texel = [[0.0f32; 8]; 3];
-            for k in 0..8 {
-                if active & (1 << k) == 0 {
-                    continue;
-                }
-                let t = texture.sample_grad(
-                    &sampler,
-                    Vec2::new(u[k], v[k]),
-                    Vec2::new(du_dx[k], dv_dx[k]),
-                    Vec2::new(du_dy[k], dv_dy[k]),
-                );
-                texel[0][k] = t.x;
-                texel[1][k] = t.y;
-                texel[2][k] = t.z;
-            }
+            let texel = texture.sample_grad_lanes::<L>(
+                &sampler,
+                [f.varying(3), f.varying(4)],
+                [du_dx, dv_dx],
+                [du_dy, dv_dy],
+                f.active,
+            );
             for c in 0..3 {
-                emissive[c] = emissive[c] * lanes.f32_from_array(texel[c]);
+                emissive[c] = emissive[c] * texel[c];
             }
         }
         emissive
     }
 
-    /// `baseColorFactor × COLOR_0 × texture(uv)` per lane; the texture is sampled lane by lane.
+    /// `baseColorFactor × COLOR_0 × texture(uv)` per lane; the texture is sampled lane-wide.
     #[inline(always)]
     fn base_color_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 4] {
         let lanes = f.lanes;
@@ -365,29 +353,17 @@ impl MaterialShader<'_> {
             lanes.splat_f32(factor[3]) * f.varying(8),
         ];
         if let Some((texture, sampler)) = self.texture {
-            let (u, v) = (f.varying(3).to_array(), f.varying(4).to_array());
             let (du_dx, du_dy) = f.derivatives(3);
             let (dv_dx, dv_dy) = f.derivatives(4);
-            let (du_dx, du_dy) = (du_dx.to_array(), du_dy.to_array());
-            let (dv_dx, dv_dy) = (dv_dx.to_array(), dv_dy.to_array());
-            let active = f.active.bits();
-            let mut texel = [[0.0f32; 8]; 4];
-            for k in 0..8 {
-                if active & (1 << k) == 0 {
-                    continue;
-                }
-                let t = texture.sample_grad(
-                    &sampler,
-                    Vec2::new(u[k], v[k]),
-                    Vec2::new(du_dx[k], dv_dx[k]),
-                    Vec2::new(du_dy[k], dv_dy[k]),
-                );
-                for (channel, value) in texel.iter_mut().zip(t.to_array()) {
-                    channel[k] = value;
-                }
-            }
+            let texel = texture.sample_grad_lanes::<L>(
+                &sampler,
+                [f.varying(3), f.varying(4)],
+                [du_dx, dv_dx],
+                [du_dy, dv_dy],
+                f.active,
+            );
             for c in 0..4 {
-                base[c] = base[c] * lanes.f32_from_array(texel[c]);
+                base[c] = base[c] * texel[c];
             }
         }
         base
