@@ -1,10 +1,10 @@
-//! Scene data in GL objects: one vertex array + vertex buffer + index buffer per mesh, one RGBA32F
-//! texture with its complete mip chain per texture, one sampler object per textured material.
+//! Scene data in GL objects: one vertex array + vertex buffer + index buffer per mesh, one RGBA8 /
+//! SRGB8_ALPHA8 texture with its complete mip chain per texture, one sampler object per textured material.
 
 use glow::HasContext;
 use kantele::material::StandardVertex;
 use kantele::scene::{Material, Mesh, Scene};
-use kantele::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
+use kantele::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
 
 /// Floats per vertex: position 3, normal 3, texcoord 2, colour 4.
 pub(crate) const VERTEX_FLOATS: usize = 12;
@@ -25,6 +25,8 @@ pub(crate) struct GpuScene {
     pub(crate) textures: Vec<glow::Texture>,
     /// Per material: the sampler object of its base colour texture, if it has one.
     pub(crate) samplers: Vec<Option<glow::Sampler>>,
+    /// Per material: the sampler object of its emissive texture, if it has one.
+    pub(crate) emissive_samplers: Vec<Option<glow::Sampler>>,
 }
 
 /// Interleaved vertices (position, normal, texcoord, colour: [`VERTEX_FLOATS`] floats) and u32
@@ -88,7 +90,8 @@ pub(crate) unsafe fn upload_mesh(gl: &glow::Context, mesh: &Mesh) -> Result<GpuM
     }
 }
 
-/// Uploads a texture with every level of its mip chain as GL_RGBA32F, rows in memory order: the
+/// Uploads a texture with every level of its mip chain as its 8-bit texels (GL_SRGB8_ALPHA8 for
+/// an sRGB texture, GL_RGBA8 otherwise, so GL decodes them as Kantele does), rows in memory order: the
 /// first row of a kantele level (the image's top row, addressed by v = 0 as in glTF) becomes GL's
 /// t = 0 row, so no flip is needed anywhere.
 ///
@@ -100,7 +103,7 @@ pub(crate) unsafe fn upload_texture(
 ) -> Result<glow::Texture, String> {
     let levels = texture.levels();
     // SAFETY: the context is current (caller's contract); the texture is created here; each
-    // level's byte slice holds exactly width × height RGBA f32 texels as declared.
+    // level's byte slice holds exactly width × height RGBA8 texels as declared.
     unsafe {
         let max_size = gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE);
         if texture.width() as i64 > max_size as i64 || texture.height() as i64 > max_size as i64 {
@@ -114,17 +117,22 @@ pub(crate) unsafe fn upload_texture(
         gl.bind_texture(glow::TEXTURE_2D, Some(handle));
         gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
         gl.pixel_store_i32(glow::UNPACK_ROW_LENGTH, 0);
-        for (level, mip) in levels.iter().enumerate() {
-            let bytes = f32_bytes(mip.texels.iter().flat_map(|t| t.to_array()));
+        let internal_format = match texture.source_color_space() {
+            ColorSpace::Srgb => glow::SRGB8_ALPHA8,
+            ColorSpace::Linear => glow::RGBA8,
+        };
+        let level_count = levels.len();
+        for (level, mip) in levels.enumerate() {
+            let bytes: Vec<u8> = mip.texels.iter().flat_map(|t| t.to_le_bytes()).collect();
             gl.tex_image_2d(
                 glow::TEXTURE_2D,
                 level as i32,
-                glow::RGBA32F as i32,
+                internal_format as i32,
                 mip.width as i32,
                 mip.height as i32,
                 0,
                 glow::RGBA,
-                glow::FLOAT,
+                glow::UNSIGNED_BYTE,
                 glow::PixelUnpackData::Slice(Some(&bytes)),
             );
         }
@@ -132,7 +140,7 @@ pub(crate) unsafe fn upload_texture(
         gl.tex_parameter_i32(
             glow::TEXTURE_2D,
             glow::TEXTURE_MAX_LEVEL,
-            levels.len() as i32 - 1,
+            level_count as i32 - 1,
         );
         gl.bind_texture(glow::TEXTURE_2D, None);
         Ok(handle)
@@ -219,6 +227,12 @@ impl GpuScene {
                     None => None,
                 };
                 gpu.samplers.push(sampler);
+                let emissive = match material.emissive_texture.map(|b| b.sampler) {
+                    // SAFETY: forwarded caller's contract.
+                    Some(s) => Some(unsafe { create_sampler(gl, &s) }?),
+                    None => None,
+                };
+                gpu.emissive_samplers.push(emissive);
             }
             Ok(())
         })();
@@ -249,6 +263,9 @@ impl GpuScene {
                 gl.delete_texture(t);
             }
             for s in self.samplers.drain(..).flatten() {
+                gl.delete_sampler(s);
+            }
+            for s in self.emissive_samplers.drain(..).flatten() {
                 gl.delete_sampler(s);
             }
         }

@@ -47,6 +47,9 @@ in vec4 v_color;
 uniform vec4 u_base_color_factor;
 uniform bool u_has_texture;
 uniform sampler2D u_base_color_texture;
+uniform vec3 u_emissive;        // linear emitted colour, added after lighting
+uniform bool u_has_emissive_texture;
+uniform sampler2D u_emissive_texture;
 uniform bool u_unlit;
 uniform int u_alpha_mode;      // 0 opaque, 1 mask, 2 blend
 uniform float u_alpha_cutoff;
@@ -60,7 +63,7 @@ uniform vec2 u_ids;            // node index + 1, draw index + 1
 layout(location = 0) out vec4 o_color;
 
 void main() {
-    // Texels are RGBA32F holding the already-decoded linear values of kantele's mip chain.
+    // Texels are kantele's 8-bit mip chain (SRGB8_ALPHA8 or RGBA8), decoded to linear by GL.
     vec4 base = u_base_color_factor * v_color;
     if (u_has_texture) {
         base *= texture(u_base_color_texture, v_texcoord);
@@ -85,6 +88,11 @@ void main() {
     vec3 rgb = base.rgb;
     if (!u_unlit) {
         rgb = base.rgb * (u_ambient + (1.0 - u_ambient) * max(0.0, dot(n, u_to_light)) * u_light_color);
+        vec3 emissive = u_emissive;
+        if (u_has_emissive_texture) {
+            emissive *= texture(u_emissive_texture, v_texcoord).rgb;
+        }
+        rgb += emissive;
     }
     float a = u_alpha_mode == 2 ? base.a : 1.0;
     o_color = vec4(rgb, a);

@@ -1,13 +1,23 @@
-//! Textures and samplers: texel storage with a mip chain, wrap modes, nearest / bilinear /
+//! Textures and samplers: 8-bit texel storage with a mip chain, wrap modes, nearest / bilinear /
 //! trilinear filtering and the level-of-detail rule of OpenGL.
 //!
-//! Texels are stored as linear `f32` RGBA. sRGB-encoded images are decoded when the texture is
-//! created (as a GPU's sRGB formats decode before filtering), and mip levels are built by averaging
-//! 2 × 2 texels in linear space.
+//! Texels are stored as packed RGBA8 ([`texel`](super::texel)), every level of the mip chain in
+//! one `Vec<u32>` with a per-level table (offset, width, height): a 4096 × 4096 texture with its
+//! chain takes 89.5 MB. sRGB textures keep their sRGB-encoded bytes, as OpenGL's
+//! `GL_SRGB8_ALPHA8`, and are decoded to linear through a 256-entry table *before* filtering.
+//! Mip levels are built by averaging 2 × 2 texels in linear space, then re-encoded (sRGB or
+//! linear) to 8 bits with round-to-nearest. Float images ([`Texture::from_rgba_f32`]) are
+//! quantised to linear 8 bits.
+//!
+//! Two samplers read that storage: the scalar [`Texture::sample_grad`] / [`Texture::sample_lod`]
+//! (for user shaders, one pixel at a time) and the lane-wide [`Texture::sample_grad_lanes`]
+//! (eight pixels at a time, used by the built-in materials). They apply the same rules; their
+//! results may differ in the last bits (the lane sampler computes `log2` with a polynomial and
+//! filters linear channels before dividing by 255).
 
 use glam::{Vec2, Vec4};
 
-use crate::color::srgb_to_linear;
+use super::texel::{decode_table, decode_texel, encode_texel, pack_rgba8, unpack_rgba8};
 use crate::error::RenderError;
 
 /// Largest texture side accepted (texels).
@@ -22,34 +32,69 @@ pub enum ColorSpace {
     Srgb,
 }
 
-/// One level of a mip chain.
-#[derive(Clone, Debug)]
-pub struct MipLevel {
+/// One level of a mip chain: a view into the texture's storage.
+#[derive(Clone, Copy, Debug)]
+pub struct MipLevel<'a> {
     /// Width in texels.
     pub width: u32,
     /// Height in texels.
     pub height: u32,
-    /// Row-major texels, row 0 first (the top row of the source image), linear RGBA.
-    pub texels: Vec<Vec4>,
+    /// Row-major packed RGBA8 texels ([`pack_rgba8`]), row 0 first (the top row of the source
+    /// image), encoded in the texture's [`ColorSpace`].
+    pub texels: &'a [u32],
+    /// The encoding of the red, green and blue bytes.
+    pub color_space: ColorSpace,
 }
 
-impl MipLevel {
+impl MipLevel<'_> {
+    /// The texel at column `x`, row `y`, decoded to linear RGBA. Panics outside the level.
     #[inline]
-    fn fetch(&self, x: u32, y: u32) -> Vec4 {
-        self.texels[(y * self.width + x) as usize]
+    pub fn texel(&self, x: u32, y: u32) -> Vec4 {
+        decode_texel(self.packed(x, y), self.color_space)
+    }
+
+    /// The packed texel at column `x`, row `y`. Panics outside the level.
+    #[inline]
+    pub fn packed(&self, x: u32, y: u32) -> u32 {
+        self.texels[y as usize * self.width as usize + x as usize]
     }
 }
 
-/// A 2D texture with its complete mip chain, in linear `f32` RGBA.
-#[derive(Clone, Debug)]
+/// Where each mip level lies in the texel storage, one entry per level (level 0 first). Kept as
+/// three arrays so the lane-wide sampler can gather a lane's level offset and size.
+#[derive(Clone, Debug, Default)]
+pub(super) struct LevelTable {
+    /// Index of each level's first texel.
+    pub(super) offsets: Vec<u32>,
+    /// Width of each level in texels.
+    pub(super) widths: Vec<u32>,
+    /// Height of each level in texels.
+    pub(super) heights: Vec<u32>,
+}
+
+/// A 2D texture with its complete mip chain, stored as packed RGBA8.
+#[derive(Clone)]
 pub struct Texture {
-    levels: Vec<MipLevel>,
-    source_color_space: ColorSpace,
+    /// Every level's texels, level 0 first, each row-major.
+    pub(super) texels: Vec<u32>,
+    pub(super) levels: LevelTable,
+    pub(super) color_space: ColorSpace,
+}
+
+impl std::fmt::Debug for Texture {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Texture")
+            .field("width", &self.width())
+            .field("height", &self.height())
+            .field("levels", &self.level_count())
+            .field("color_space", &self.color_space)
+            .finish_non_exhaustive()
+    }
 }
 
 impl Texture {
-    /// Creates a texture from 8-bit RGBA texels (row 0 = top row), decoding sRGB if asked,
-    /// and builds the full mip chain.
+    /// Creates a texture from 8-bit RGBA texels (row 0 = top row) encoded in `color_space`, kept
+    /// as they are, and builds the full mip chain.
     pub fn from_rgba8(
         width: u32,
         height: u32,
@@ -64,37 +109,17 @@ impl Texture {
                 actual: rgba.len(),
             });
         }
-        let texels = rgba
+        let level0 = rgba
             .chunks_exact(4)
-            .map(|p| {
-                let a = p[3] as f32 / 255.0;
-                match color_space {
-                    ColorSpace::Srgb => Vec4::new(
-                        srgb_to_linear(p[0] as f32 / 255.0),
-                        srgb_to_linear(p[1] as f32 / 255.0),
-                        srgb_to_linear(p[2] as f32 / 255.0),
-                        a,
-                    ),
-                    ColorSpace::Linear => Vec4::new(
-                        p[0] as f32 / 255.0,
-                        p[1] as f32 / 255.0,
-                        p[2] as f32 / 255.0,
-                        a,
-                    ),
-                }
-            })
+            .map(|p| pack_rgba8([p[0], p[1], p[2], p[3]]))
             .collect();
-        Ok(Self::from_level0(
-            MipLevel {
-                width,
-                height,
-                texels,
-            },
-            color_space,
-        ))
+        Ok(Self::from_level0(width, height, level0, color_space))
     }
 
-    /// Creates a texture from linear float RGBA texels (row 0 = top row) and builds the mip chain.
+    /// Creates a linear texture from float RGBA texels (row 0 = top row) and builds the mip chain.
+    ///
+    /// The texels are **quantised** to linear 8 bits per channel (clamped to [0, 1], rounded to
+    /// the nearest of `k / 255`, NaN becomes 0), as an upload to `GL_RGBA8` would.
     pub fn from_rgba_f32(width: u32, height: u32, texels: Vec<Vec4>) -> Result<Self, RenderError> {
         check_texture_size(width, height)?;
         let expected = width as usize * height as usize;
@@ -104,45 +129,86 @@ impl Texture {
                 actual: texels.len(),
             });
         }
-        Ok(Self::from_level0(
-            MipLevel {
-                width,
-                height,
-                texels,
-            },
-            ColorSpace::Linear,
-        ))
+        let level0 = texels
+            .iter()
+            .map(|&t| encode_texel(t, ColorSpace::Linear))
+            .collect();
+        Ok(Self::from_level0(width, height, level0, ColorSpace::Linear))
     }
 
-    fn from_level0(level0: MipLevel, source_color_space: ColorSpace) -> Self {
-        let mut levels = vec![level0];
-        while let Some(next) = downsample(levels.last().expect("level 0 exists")) {
-            levels.push(next);
+    fn from_level0(width: u32, height: u32, level0: Vec<u32>, color_space: ColorSpace) -> Self {
+        let mut sizes = vec![(width, height)];
+        while let Some(&(w, h)) = sizes.last().filter(|&&(w, h)| w > 1 || h > 1) {
+            sizes.push(((w / 2).max(1), (h / 2).max(1)));
         }
+        let total: usize = sizes.iter().map(|&(w, h)| w as usize * h as usize).sum();
+        let mut texels = level0;
+        texels.reserve_exact(total - texels.len());
+        let mut levels = LevelTable::default();
+        let mut offset = 0usize;
+        for (i, &(w, h)) in sizes.iter().enumerate() {
+            if i > 0 {
+                let (pw, ph) = sizes[i - 1];
+                let previous = offset - pw as usize * ph as usize;
+                downsample(&mut texels, previous, (pw, ph), color_space);
+            }
+            // At most 16384² × 4/3 texels: fits in u32 (and i32, for the gathers).
+            levels.offsets.push(offset as u32);
+            levels.widths.push(w);
+            levels.heights.push(h);
+            offset += w as usize * h as usize;
+        }
+        debug_assert_eq!(texels.len(), total);
         Self {
+            texels,
             levels,
-            source_color_space,
+            color_space,
         }
     }
 
     /// Width of level 0 in texels.
     pub fn width(&self) -> u32 {
-        self.levels[0].width
+        self.levels.widths[0]
     }
 
     /// Height of level 0 in texels.
     pub fn height(&self) -> u32 {
-        self.levels[0].height
+        self.levels.heights[0]
+    }
+
+    /// How many levels the mip chain has (level 0 down to 1 × 1).
+    pub fn level_count(&self) -> usize {
+        self.levels.offsets.len()
+    }
+
+    /// Level `index` of the mip chain, `None` past the last.
+    pub fn level(&self, index: usize) -> Option<MipLevel<'_>> {
+        let offset = *self.levels.offsets.get(index)? as usize;
+        let (width, height) = (self.levels.widths[index], self.levels.heights[index]);
+        Some(MipLevel {
+            width,
+            height,
+            texels: &self.texels[offset..offset + width as usize * height as usize],
+            color_space: self.color_space,
+        })
     }
 
     /// The mip chain, level 0 first, down to 1 × 1.
-    pub fn levels(&self) -> &[MipLevel] {
-        &self.levels
+    pub fn levels(&self) -> impl ExactSizeIterator<Item = MipLevel<'_>> + '_ {
+        (0..self.level_count()).map(|i| self.level(i).expect("index below level_count"))
     }
 
-    /// The encoding of the 8-bit data the texture was made from.
+    /// The encoding of the stored red, green and blue bytes (the 8-bit data the texture was made
+    /// from; [`ColorSpace::Linear`] for float images).
     pub fn source_color_space(&self) -> ColorSpace {
-        self.source_color_space
+        self.color_space
+    }
+
+    /// Bytes of memory the texture holds: the texels of every level and the level table.
+    pub fn memory_bytes(&self) -> usize {
+        std::mem::size_of::<Self>()
+            + self.texels.capacity() * std::mem::size_of::<u32>()
+            + 3 * self.levels.offsets.capacity() * std::mem::size_of::<u32>()
     }
 
     /// Samples at `uv` with the level of detail computed from the screen-space derivatives of
@@ -166,8 +232,20 @@ impl Texture {
             f32::NEG_INFINITY
         } else {
             // Non-finite derivatives (degenerate mapping): use the smallest level.
-            (self.levels.len() - 1) as f32
+            self.max_level() as f32
         }
+    }
+
+    /// Index of the last (1 × 1) level.
+    #[inline]
+    pub(super) fn max_level(&self) -> usize {
+        self.level_count() - 1
+    }
+
+    #[inline]
+    fn level_unchecked(&self, index: usize) -> MipLevel<'_> {
+        self.level(index.min(self.max_level()))
+            .expect("index clamped to the chain")
     }
 
     /// Samples at `uv` with an explicit level of detail (OpenGL 4.6 §8.14–8.15).
@@ -183,32 +261,33 @@ impl Texture {
         }
         // The magnification / minification switch point c is 0 (mag filter LINEAR or min filter
         // not NEAREST_MIPMAP_LINEAR / LINEAR_MIPMAP_NEAREST gives c = 0 in the spec).
+        let level = |i: usize| self.level_unchecked(i);
         if lod <= 0.0 || lod.is_nan() {
-            return sample_level(&self.levels[0], sampler, sampler.mag_filter, uv);
+            return sample_level(&level(0), sampler, sampler.mag_filter, uv);
         }
-        let max_level = (self.levels.len() - 1) as f32;
+        let max_level = self.max_level() as f32;
         match sampler.min_filter {
-            MinFilter::Nearest => sample_level(&self.levels[0], sampler, Filter::Nearest, uv),
-            MinFilter::Linear => sample_level(&self.levels[0], sampler, Filter::Linear, uv),
+            MinFilter::Nearest => sample_level(&level(0), sampler, Filter::Nearest, uv),
+            MinFilter::Linear => sample_level(&level(0), sampler, Filter::Linear, uv),
             MinFilter::NearestMipmapNearest | MinFilter::LinearMipmapNearest => {
                 let filter = sampler.min_filter.texel_filter();
                 // d = ceil(λ + 1/2) − 1, clamped to the chain.
-                let level = if lod <= 0.5 {
+                let d = if lod <= 0.5 {
                     0.0
                 } else {
                     (-floor(-(lod + 0.5)) - 1.0).min(max_level)
                 };
-                sample_level(&self.levels[level as usize], sampler, filter, uv)
+                sample_level(&level(d as usize), sampler, filter, uv)
             }
             MinFilter::NearestMipmapLinear | MinFilter::LinearMipmapLinear => {
                 let filter = sampler.min_filter.texel_filter();
                 if lod >= max_level {
-                    return sample_level(&self.levels[max_level as usize], sampler, filter, uv);
+                    return sample_level(&level(max_level as usize), sampler, filter, uv);
                 }
                 let lower = floor(lod);
                 let frac = lod - lower;
-                let a = sample_level(&self.levels[lower as usize], sampler, filter, uv);
-                let b = sample_level(&self.levels[lower as usize + 1], sampler, filter, uv);
+                let a = sample_level(&level(lower as usize), sampler, filter, uv);
+                let b = sample_level(&level(lower as usize + 1), sampler, filter, uv);
                 a * (1.0 - frac) + b * frac
             }
         }
@@ -222,32 +301,37 @@ fn check_texture_size(width: u32, height: u32) -> Result<(), RenderError> {
     Ok(())
 }
 
-/// Next mip level: each texel is the mean of the (up to) 2 × 2 texels it covers.
-fn downsample(level: &MipLevel) -> Option<MipLevel> {
-    if level.width == 1 && level.height == 1 {
-        return None;
-    }
-    let width = (level.width / 2).max(1);
-    let height = (level.height / 2).max(1);
-    let mut texels = Vec::with_capacity(width as usize * height as usize);
-    for y in 0..height {
-        let y0 = (2 * y).min(level.height - 1);
-        let y1 = (2 * y + 1).min(level.height - 1);
-        for x in 0..width {
-            let x0 = (2 * x).min(level.width - 1);
-            let x1 = (2 * x + 1).min(level.width - 1);
-            let sum = level.fetch(x0, y0)
-                + level.fetch(x1, y0)
-                + level.fetch(x0, y1)
-                + level.fetch(x1, y1);
-            texels.push(sum * 0.25);
+/// Appends the level below the one at `texels[previous..]` of size `(width, height)`: each
+/// texel is the mean of the (up to) 2 × 2 texels it covers, averaged in linear space (clamping at
+/// odd edges) and re-encoded to 8 bits with round-to-nearest.
+fn downsample(
+    texels: &mut Vec<u32>,
+    previous: usize,
+    (width, height): (u32, u32),
+    color_space: ColorSpace,
+) {
+    let (w, h) = ((width / 2).max(1), (height / 2).max(1));
+    let table = decode_table(color_space);
+    let decode = |texel: u32| {
+        let [r, g, b, a] = unpack_rgba8(texel);
+        let channel = |byte: u8| f32::from_bits(table[byte as usize]);
+        Vec4::new(channel(r), channel(g), channel(b), a as f32 / 255.0)
+    };
+    let mut row = Vec::with_capacity(w as usize);
+    for y in 0..h {
+        let y0 = (2 * y).min(height - 1) as usize;
+        let y1 = (2 * y + 1).min(height - 1) as usize;
+        let above = &texels[previous + y0 * width as usize..][..width as usize];
+        let below = &texels[previous + y1 * width as usize..][..width as usize];
+        row.clear();
+        for x in 0..w {
+            let x0 = (2 * x).min(width - 1) as usize;
+            let x1 = (2 * x + 1).min(width - 1) as usize;
+            let sum = decode(above[x0]) + decode(above[x1]) + decode(below[x0]) + decode(below[x1]);
+            row.push(encode_texel(sum * 0.25, color_space));
         }
+        texels.extend_from_slice(&row);
     }
-    Some(MipLevel {
-        width,
-        height,
-        texels,
-    })
 }
 
 /// Texel filter within one level.
@@ -279,7 +363,7 @@ pub enum MinFilter {
 }
 
 impl MinFilter {
-    fn texel_filter(self) -> Filter {
+    pub(super) fn texel_filter(self) -> Filter {
         match self {
             MinFilter::Nearest
             | MinFilter::NearestMipmapNearest
@@ -330,15 +414,17 @@ impl Wrap {
 }
 
 impl Wrap {
-    /// Moves a coordinate into the first period of a repeating mode ([0, 1) for REPEAT,
-    /// [0, 2) for MIRRORED_REPEAT) so texel indices stay small and mostly inside the texture;
-    /// CLAMP_TO_EDGE is left alone.
+    /// The coordinate `t` in texels of a level `size` texels wide, moved into the first period
+    /// of a repeating mode ([0, size] for REPEAT, [0, 2·size] for MIRRORED_REPEAT) so texel
+    /// indices stay small and mostly inside the texture. CLAMP_TO_EDGE is limited to
+    /// [−2, size + 2], which changes no texel or weight that is read and keeps huge coordinates
+    /// finite.
     #[inline]
-    fn reduce(self, t: f32) -> f32 {
+    fn to_texels(self, t: f32, size: f32) -> f32 {
         match self {
-            Wrap::Repeat => t - floor(t),
-            Wrap::MirroredRepeat => t - 2.0 * floor(t * 0.5),
-            Wrap::ClampToEdge => t,
+            Wrap::Repeat => (t - floor(t)) * size,
+            Wrap::MirroredRepeat => (t - 2.0 * floor(t * 0.5)) * size,
+            Wrap::ClampToEdge => (t * size).clamp(-2.0, size + 2.0),
         }
     }
 }
@@ -358,16 +444,16 @@ pub struct Sampler {
 
 /// Samples one level with one filter. `uv` (0, 0) is the top-left corner of the image (the first
 /// texel in memory), as in glTF.
-fn sample_level(level: &MipLevel, sampler: &Sampler, filter: Filter, uv: Vec2) -> Vec4 {
+fn sample_level(level: &MipLevel<'_>, sampler: &Sampler, filter: Filter, uv: Vec2) -> Vec4 {
     let w = level.width as i32;
     let h = level.height as i32;
-    let u = sampler.wrap_s.reduce(uv.x) * w as f32;
-    let v = sampler.wrap_t.reduce(uv.y) * h as f32;
+    let u = sampler.wrap_s.to_texels(uv.x, w as f32);
+    let v = sampler.wrap_t.to_texels(uv.y, h as f32);
     match filter {
         Filter::Nearest => {
             let i = sampler.wrap_s.apply(floor_to_i32(u), w);
             let j = sampler.wrap_t.apply(floor_to_i32(v), h);
-            level.fetch(i as u32, j as u32)
+            level.texel(i as u32, j as u32)
         }
         Filter::Linear => {
             let us = u - 0.5;
@@ -382,8 +468,8 @@ fn sample_level(level: &MipLevel, sampler: &Sampler, filter: Filter, uv: Vec2) -
             let x1 = sampler.wrap_s.apply(i0.wrapping_add(1), w) as u32;
             let y0 = sampler.wrap_t.apply(j0, h) as u32;
             let y1 = sampler.wrap_t.apply(j0.wrapping_add(1), h) as u32;
-            let top = level.fetch(x0, y0) * (1.0 - alpha) + level.fetch(x1, y0) * alpha;
-            let bottom = level.fetch(x0, y1) * (1.0 - alpha) + level.fetch(x1, y1) * alpha;
+            let top = level.texel(x0, y0) * (1.0 - alpha) + level.texel(x1, y0) * alpha;
+            let bottom = level.texel(x0, y1) * (1.0 - alpha) + level.texel(x1, y1) * alpha;
             top * (1.0 - beta) + bottom * beta
         }
     }
@@ -444,10 +530,10 @@ mod tests {
         assert_eq!(floor_to_i32(-1e20), i32::MIN);
     }
 
-    /// A 4 × 1 texture with texel values 0, 1, 2, 3 in red.
+    /// A 4 × 1 linear texture with red 0, 1/3, 2/3, 1 (bytes 0, 85, 170, 255).
     fn ramp() -> Texture {
-        let texels = (0..4).map(|i| Vec4::new(i as f32, 0.0, 0.0, 1.0)).collect();
-        Texture::from_rgba_f32(4, 1, texels).expect("texture")
+        let rgba = [0u8, 85, 170, 255].map(|r| [r, 0, 0, 255]).concat();
+        Texture::from_rgba8(4, 1, &rgba, ColorSpace::Linear).expect("texture")
     }
 
     fn sampler(wrap: Wrap, filter: Filter) -> Sampler {
@@ -463,8 +549,10 @@ mod tests {
     fn nearest_with_each_wrap_mode() {
         let t = ramp();
         let red = |wrap, u: f32| {
-            t.sample_lod(&sampler(wrap, Filter::Nearest), Vec2::new(u, 0.5), 0.0)
-                .x
+            let r = t
+                .sample_lod(&sampler(wrap, Filter::Nearest), Vec2::new(u, 0.5), 0.0)
+                .x;
+            (r * 3.0).round()
         };
         // Texel i covers u in [i/4, (i+1)/4).
         assert_eq!(red(Wrap::Repeat, 0.1), 0.0);
@@ -484,7 +572,8 @@ mod tests {
     fn bilinear_blends_texel_centres() {
         let t = ramp();
         let red = |wrap, u: f32| {
-            t.sample_lod(&sampler(wrap, Filter::Linear), Vec2::new(u, 0.5), 0.0)
+            3.0 * t
+                .sample_lod(&sampler(wrap, Filter::Linear), Vec2::new(u, 0.5), 0.0)
                 .x
         };
         // Centres at u = (i + 0.5) / 4: exact values there, linear in between.
@@ -498,46 +587,93 @@ mod tests {
 
     #[test]
     fn mip_chain_averages_in_linear_space() {
-        // sRGB 188 ≈ linear 0.5; a 2 × 2 of black and sRGB-white averages to linear 0.5.
+        // sRGB 188 ≈ linear 0.5; a 2 × 2 of black and sRGB-white averages to linear 0.5, stored
+        // as the sRGB byte 188.
         let rgba = [
             0, 0, 0, 255, 255, 255, 255, 255, 255, 255, 255, 255, 0, 0, 0, 255,
         ];
         let t = Texture::from_rgba8(2, 2, &rgba, ColorSpace::Srgb).expect("texture");
         assert_eq!(t.levels().len(), 2);
-        let top = t.levels()[1].texels[0];
-        assert!((top.x - 0.5).abs() < 1e-6, "{top:?}");
+        let top = t.level(1).expect("level 1");
+        assert_eq!(unpack_rgba8(top.texels[0]), [188, 188, 188, 255]);
+        assert!(
+            (top.texel(0, 0).x - 0.5).abs() < 4e-3,
+            "{:?}",
+            top.texel(0, 0)
+        );
+        // Linear textures average the values: (0 + 255 + 255 + 0) / 4 = 127.5 rounds to 128.
+        let t = Texture::from_rgba8(2, 2, &rgba, ColorSpace::Linear).expect("texture");
+        assert_eq!(
+            unpack_rgba8(t.level(1).expect("level 1").texels[0]),
+            [128, 128, 128, 255]
+        );
         // Non-square and odd sizes go down to 1 × 1.
         let odd = Texture::from_rgba_f32(5, 3, vec![Vec4::ONE; 15]).expect("texture");
-        let sizes: Vec<(u32, u32)> = odd.levels().iter().map(|l| (l.width, l.height)).collect();
+        let sizes: Vec<(u32, u32)> = odd.levels().map(|l| (l.width, l.height)).collect();
         assert_eq!(sizes, vec![(5, 3), (2, 1), (1, 1)]);
-        assert_eq!(odd.levels()[2].texels[0], Vec4::ONE);
+        assert_eq!(odd.level(2).expect("level 2").texel(0, 0), Vec4::ONE);
+        assert!(odd.level(3).is_none());
+    }
+
+    #[test]
+    fn float_images_are_quantised_to_8_bits() {
+        let t = Texture::from_rgba_f32(
+            2,
+            1,
+            vec![
+                Vec4::new(0.5, -1.0, 2.0, f32::NAN),
+                Vec4::new(0.2, 0.4, 0.6, 0.8),
+            ],
+        )
+        .expect("texture");
+        let level = t.level(0).expect("level 0");
+        assert_eq!(unpack_rgba8(level.texels[0]), [128, 0, 255, 0]);
+        assert_eq!(unpack_rgba8(level.texels[1]), [51, 102, 153, 204]);
+        assert_eq!(level.texel(1, 0), Vec4::new(0.2, 0.4, 0.6, 0.8));
+    }
+
+    #[test]
+    fn a_4096_texture_with_mips_fits_in_96_mb() {
+        let size = 4096u32;
+        let rgba = vec![200u8; (size * size * 4) as usize];
+        let t = Texture::from_rgba8(size, size, &rgba, ColorSpace::Linear).expect("texture");
+        assert_eq!(t.level_count(), 13);
+        let texels: usize = t.levels().map(|l| l.texels.len()).sum();
+        assert_eq!(texels, 22_369_621); // (4^13 − 1) / 3
+        let bytes = t.memory_bytes();
+        assert!(bytes >= texels * 4, "{bytes}");
+        assert!(bytes <= 96_000_000, "{bytes} bytes");
     }
 
     #[test]
     fn level_selection_follows_opengl() {
-        // Level i has red = i (set the levels by hand to see which is read).
+        // Level i has red = i / 255 (set the levels by hand to see which is read).
         let mut t = Texture::from_rgba_f32(8, 8, vec![Vec4::ZERO; 64]).expect("texture");
-        for (i, level) in t.levels.iter_mut().enumerate() {
-            level.texels.fill(Vec4::new(i as f32, 0.0, 0.0, 1.0));
+        for i in 0..t.level_count() {
+            let offset = t.levels.offsets[i] as usize;
+            let len = (t.levels.widths[i] * t.levels.heights[i]) as usize;
+            t.texels[offset..offset + len].fill(pack_rgba8([i as u8, 0, 0, 255]));
         }
         let with = |min_filter| Sampler {
             min_filter,
             ..Sampler::default()
         };
         let uv = Vec2::splat(0.3);
-        let red = |min, lod: f32| t.sample_lod(&with(min), uv, lod).x;
-        assert_eq!(red(MinFilter::LinearMipmapNearest, 0.4), 0.0);
-        assert_eq!(red(MinFilter::LinearMipmapNearest, 0.6), 1.0);
-        assert_eq!(red(MinFilter::NearestMipmapNearest, 1.49), 1.0);
-        assert_eq!(red(MinFilter::NearestMipmapNearest, 1.51), 2.0);
-        assert!((red(MinFilter::LinearMipmapLinear, 1.25) - 1.25).abs() < 1e-6);
-        assert_eq!(red(MinFilter::LinearMipmapLinear, 10.0), 3.0);
-        assert_eq!(red(MinFilter::Linear, 2.0), 0.0, "no mipmaps: level 0");
-        assert_eq!(
-            red(MinFilter::LinearMipmapLinear, -1.0),
-            0.0,
-            "magnified: level 0"
-        );
+        let red = |min, lod: f32| t.sample_lod(&with(min), uv, lod).x * 255.0;
+        let cases = [
+            (MinFilter::LinearMipmapNearest, 0.4, 0.0),
+            (MinFilter::LinearMipmapNearest, 0.6, 1.0),
+            (MinFilter::NearestMipmapNearest, 1.49, 1.0),
+            (MinFilter::NearestMipmapNearest, 1.51, 2.0),
+            (MinFilter::LinearMipmapLinear, 1.25, 1.25),
+            (MinFilter::LinearMipmapLinear, 10.0, 3.0),
+            (MinFilter::Linear, 2.0, 0.0), // no mipmaps: level 0
+            (MinFilter::LinearMipmapLinear, -1.0, 0.0), // magnified: level 0
+        ];
+        for (min, lod, expected) in cases {
+            let got = red(min, lod);
+            assert!((got - expected).abs() < 1e-4, "{min:?} at λ {lod}: {got}");
+        }
         // λ = log2 of the larger footprint in texels.
         assert!((t.lod(Vec2::new(0.5, 0.0), Vec2::new(0.0, 0.125)) - 2.0).abs() < 1e-6);
     }

@@ -1,0 +1,658 @@
+//! Lane-wide texture sampling: eight pixels at a time, written once over [`Lanes`] and compiled
+//! per instruction set.
+//!
+//! The rules are those of the scalar sampler ([`Texture::sample_lod`]): the level of detail per
+//! lane from the analytic derivatives (OpenGL 4.6 §8.14), magnification or minification per
+//! lane, every wrap mode and every filter. Texels are fetched with [`I32x8::gather_u32`] (each
+//! lane's level offset and size gathered from the level table), unpacked and decoded lane-wide.
+//! Every step is the same `f32` / `i32` operation in the same order on every instruction set (no
+//! fused multiply-add), so the scalar build and the SIMD builds give identical bits.
+//!
+//! Against the scalar sampler, results may differ in the last bits: `log2` is a polynomial here
+//! (absolute error below 1e-6 for the level of detail), and linear channels (alpha, and all four
+//! in a linear texture) are filtered as bytes and divided by 255 once at the end.
+
+use crate::simd::{F32x8, I32x8, Lanes, Mask8, MaskOf};
+
+use super::texel::decode_table;
+use super::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
+
+/// One lane value per texel byte: red, green and blue decoded to linear (sRGB) or raw bytes
+/// (linear), alpha always a raw byte.
+type Channels<L> = [<L as Lanes>::F32; 4];
+
+impl Texture {
+    /// Samples eight texture coordinates at once, each with the level of detail from its own
+    /// screen-space derivatives (per pixel, in texture-coordinate units), as
+    /// [`Texture::sample_grad`] does for one.
+    ///
+    /// `uv`, `duv_dx` and `duv_dy` hold `[u, v]`, `[∂u/∂x, ∂v/∂x]` and `[∂u/∂y, ∂v/∂y]` as
+    /// lanes. Returns linear `[r, g, b, a]` lanes. Lanes outside `active` are not sampled, and
+    /// they and lanes with a NaN or infinite coordinate give 0 (as [`Texture::sample_lod`]).
+    #[inline(always)]
+    pub fn sample_grad_lanes<L: Lanes>(
+        &self,
+        sampler: &Sampler,
+        uv: [L::F32; 2],
+        duv_dx: [L::F32; 2],
+        duv_dy: [L::F32; 2],
+        active: MaskOf<L>,
+    ) -> [L::F32; 4] {
+        let lanes = active.lanes();
+        let zero = lanes.splat_f32(0.0);
+        #[cfg(feature = "fault-injection")]
+        let uv = if crate::fault::active(crate::fault::Fault::FlipV) {
+            [uv[0], lanes.splat_f32(1.0) - uv[1]]
+        } else {
+            uv
+        };
+        let infinity = lanes.splat_f32(f32::INFINITY);
+        let finite = uv[0]
+            .abs()
+            .simd_lt(infinity)
+            .and(uv[1].abs().simd_lt(infinity));
+        let live = active.and(finite);
+        if live.none() {
+            return [zero; 4];
+        }
+        let lod = self.lod_lanes::<L>(duv_dx, duv_dy);
+        let selection = LevelSelection::<L>::new(self, sampler, lod);
+        let nearest = selection.nearest;
+        let first = self.sample_level_lanes::<L>(sampler, selection.first, uv, nearest, live);
+        // The second level only where some live lane blends (trilinear between levels).
+        let blend = selection.fraction.simd_gt(zero).and(live);
+        let mut texel = first;
+        if blend.any() {
+            let second = self.sample_level_lanes::<L>(sampler, selection.second, uv, nearest, live);
+            // A lane with fraction 0 keeps `first` exactly: a·1 + b·0 = a for finite b ≥ 0.
+            let keep = lanes.splat_f32(1.0) - selection.fraction;
+            for c in 0..4 {
+                texel[c] = first[c] * keep + second[c] * selection.fraction;
+            }
+        }
+        // Raw bytes to [0, 1]: alpha always, red, green and blue in a linear texture.
+        let scale = lanes.splat_f32(255.0);
+        let raw_channels = match self.color_space {
+            ColorSpace::Srgb => 3..4,
+            ColorSpace::Linear => 0..4,
+        };
+        for c in raw_channels {
+            texel[c] = texel[c] / scale;
+        }
+        for channel in &mut texel {
+            *channel = live.select_f32(*channel, zero);
+        }
+        texel
+    }
+
+    /// Per-lane level of detail `λ = ½ log2 ρ²` ([`Texture::lod`]): `−∞` where the footprint is
+    /// zero (or below the smallest normal float), the last level where it is not finite.
+    #[inline(always)]
+    fn lod_lanes<L: Lanes>(&self, duv_dx: [L::F32; 2], duv_dy: [L::F32; 2]) -> L::F32 {
+        let lanes = duv_dx[0].lanes();
+        let width = lanes.splat_f32(self.width() as f32);
+        let height = lanes.splat_f32(self.height() as f32);
+        let (rx, ry) = (
+            footprint2::<L>(duv_dx, width, height),
+            footprint2::<L>(duv_dy, width, height),
+        );
+        // `f32::max` ignores a NaN operand; the lane `max` returns `ry` when either is NaN.
+        let ry_is_nan = ry.simd_ne(ry);
+        let rho2 = ry_is_nan.select_f32(rx, rx.max(ry));
+        let normal = rho2
+            .simd_ge(lanes.splat_f32(f32::MIN_POSITIVE))
+            .and(rho2.simd_lt(lanes.splat_f32(f32::INFINITY)));
+        let tiny = rho2.simd_lt(lanes.splat_f32(f32::MIN_POSITIVE));
+        let lod = lanes.splat_f32(0.5) * log2_normal::<L>(rho2);
+        let fallback = tiny.select_f32(
+            lanes.splat_f32(f32::NEG_INFINITY),
+            lanes.splat_f32(self.max_level() as f32),
+        );
+        normal.select_f32(lod, fallback)
+    }
+
+    /// Filters one level per lane (`level` holds each lane's level index) at `uv`, nearest where
+    /// `nearest` is set and bilinear elsewhere; lanes outside `live` are unspecified. Returns
+    /// [`Channels`].
+    #[inline(always)]
+    fn sample_level_lanes<L: Lanes>(
+        &self,
+        sampler: &Sampler,
+        level: L::I32,
+        uv: [L::F32; 2],
+        nearest: MaskOf<L>,
+        live: MaskOf<L>,
+    ) -> Channels<L> {
+        let lanes = nearest.lanes();
+        let (offset, width, height) = self.level_extents::<L>(level, live);
+        let s = LaneAxis::<L>::new(sampler.wrap_s, uv[0], width);
+        let t = LaneAxis::<L>::new(sampler.wrap_t, uv[1], height);
+        if nearest.all() {
+            let i = sampler
+                .wrap_s
+                .wrap_lanes::<L>(s.coord.to_i32_floor(), width);
+            let j = sampler
+                .wrap_t
+                .wrap_lanes::<L>(t.coord.to_i32_floor(), height);
+            return self.fetch_lanes::<L>(offset + j * width + i);
+        }
+        // Bilinear: texel centres at integer + ½. A nearest lane reads texel ⌊u⌋ with weights
+        // (1, 0): t00·1 + t10·0 = t00 exactly, the nearest result.
+        let half = nearest.select_f32(lanes.splat_f32(0.0), lanes.splat_f32(0.5));
+        let (us, vs) = (s.coord - half, t.coord - half);
+        let (i0f, j0f) = (us.floor(), vs.floor());
+        let zero = lanes.splat_f32(0.0);
+        let alpha = nearest.select_f32(zero, us - i0f);
+        let beta = nearest.select_f32(zero, vs - j0f);
+        let (i0, j0) = (i0f.to_i32_trunc(), j0f.to_i32_trunc());
+        let one = lanes.splat_i32(1);
+        let x0 = sampler.wrap_s.wrap_lanes::<L>(i0, width);
+        let x1 = sampler.wrap_s.wrap_lanes::<L>(i0 + one, width);
+        let row0 = offset + sampler.wrap_t.wrap_lanes::<L>(j0, height) * width;
+        let row1 = offset + sampler.wrap_t.wrap_lanes::<L>(j0 + one, height) * width;
+        let t00 = self.fetch_lanes::<L>(row0 + x0);
+        let t10 = self.fetch_lanes::<L>(row0 + x1);
+        let t01 = self.fetch_lanes::<L>(row1 + x0);
+        let t11 = self.fetch_lanes::<L>(row1 + x1);
+        let (one_alpha, one_beta) = (lanes.splat_f32(1.0) - alpha, lanes.splat_f32(1.0) - beta);
+        // Plain loops, not closures: a closure would be compiled without the instruction set's
+        // target feature and call the lane operations out of line.
+        let mut texel = t00;
+        for c in 0..4 {
+            let top = t00[c] * one_alpha + t10[c] * alpha;
+            let bottom = t01[c] * one_alpha + t11[c] * alpha;
+            texel[c] = top * one_beta + bottom * beta;
+        }
+        texel
+    }
+
+    /// Each lane's level offset, width and height from the level table: one splat when every
+    /// `live` lane reads the same level (the common case), else gathered per lane.
+    #[inline(always)]
+    fn level_extents<L: Lanes>(&self, level: L::I32, live: MaskOf<L>) -> (L::I32, L::I32, L::I32) {
+        let lanes = live.lanes();
+        let first_live = (live.bits().trailing_zeros() as usize).min(7);
+        let first_level = level.extract(first_live);
+        let same = level
+            .simd_eq(lanes.splat_i32(first_level))
+            .or(live.not())
+            .all();
+        let table = &self.levels;
+        match usize::try_from(first_level) {
+            Ok(index) if same && index < table.offsets.len() => (
+                lanes.splat_i32(table.offsets[index] as i32),
+                lanes.splat_i32(table.widths[index] as i32),
+                lanes.splat_i32(table.heights[index] as i32),
+            ),
+            _ => (
+                level.gather_u32(&table.offsets),
+                level.gather_u32(&table.widths),
+                level.gather_u32(&table.heights),
+            ),
+        }
+    }
+
+    /// Gathers the texels at `index` and unpacks them: red, green and blue decoded through the
+    /// sRGB table in an sRGB texture, otherwise every channel as its raw byte value (0–255).
+    #[inline(always)]
+    fn fetch_lanes<L: Lanes>(&self, index: L::I32) -> Channels<L> {
+        let lanes = index.lanes();
+        let texel = index.gather_u32(&self.texels);
+        let byte = lanes.splat_i32(0xff);
+        let r = texel & byte;
+        let g = texel.shr_logical::<8>() & byte;
+        let b = texel.shr_logical::<16>() & byte;
+        let a = texel.shr_logical::<24>().to_f32();
+        match self.color_space {
+            ColorSpace::Srgb => {
+                let table = decode_table(ColorSpace::Srgb);
+                [
+                    L::F32::from_bits(r.gather_u32(table)),
+                    L::F32::from_bits(g.gather_u32(table)),
+                    L::F32::from_bits(b.gather_u32(table)),
+                    a,
+                ]
+            }
+            ColorSpace::Linear => [r.to_f32(), g.to_f32(), b.to_f32(), a],
+        }
+    }
+}
+
+/// The levels and filter each lane reads.
+struct LevelSelection<L: Lanes> {
+    /// The level read by every lane.
+    first: L::I32,
+    /// The second level of a trilinear blend.
+    second: L::I32,
+    /// Weight of `second` (0 where only `first` is read).
+    fraction: L::F32,
+    /// Lanes filtered with NEAREST (the others bilinear).
+    nearest: L::Mask,
+}
+
+impl<L: Lanes> LevelSelection<L> {
+    /// OpenGL's level selection ([`Texture::sample_lod`]) per lane: λ ≤ 0 magnifies from level 0
+    /// with the magnification filter; otherwise the minification filter picks the level(s).
+    #[inline(always)]
+    fn new(texture: &Texture, sampler: &Sampler, lod: L::F32) -> Self {
+        let lanes = lod.lanes();
+        let zero = lanes.splat_f32(0.0);
+        let max_level = lanes.splat_f32(texture.max_level() as f32);
+        let magnified = lod.simd_gt(zero).not();
+        let min_filter = sampler.min_filter;
+        let nearest_min = min_filter.texel_filter() == Filter::Nearest;
+        let nearest_mag = sampler.mag_filter == Filter::Nearest;
+        let nearest = match (nearest_mag, nearest_min) {
+            (true, true) => lanes.mask_all(true),
+            (false, false) => lanes.mask_all(false),
+            (true, false) => magnified,
+            (false, true) => magnified.not(),
+        };
+        let level_zero = lanes.splat_i32(0);
+        let (first, second, fraction) = match min_filter {
+            MinFilter::Nearest | MinFilter::Linear => (level_zero, level_zero, zero),
+            MinFilter::NearestMipmapNearest | MinFilter::LinearMipmapNearest => {
+                // d = ceil(λ + ½) − 1 = −⌊−(λ + ½)⌋ − 1, clamped to the chain; 0 for λ ≤ ½.
+                let d = (-(-(lod + lanes.splat_f32(0.5))).floor() - lanes.splat_f32(1.0))
+                    .min(max_level);
+                let d = lod.simd_le(lanes.splat_f32(0.5)).select_f32(zero, d);
+                let d = magnified.select_f32(zero, d).to_i32_trunc();
+                (d, d, zero)
+            }
+            MinFilter::NearestMipmapLinear | MinFilter::LinearMipmapLinear => {
+                let clamped = lod.simd_ge(max_level).or(magnified);
+                let lower = lod.floor();
+                let fraction = clamped.select_f32(zero, lod - lower);
+                let lower =
+                    magnified.select_f32(zero, lod.simd_ge(max_level).select_f32(max_level, lower));
+                let first = lower.to_i32_trunc();
+                (first, first + lanes.splat_i32(1), fraction)
+            }
+        };
+        Self {
+            first,
+            second,
+            fraction,
+            nearest,
+        }
+    }
+}
+
+/// One texture axis of eight lanes: the coordinate in texels of the level, reduced to the first
+/// period of a repeating wrap mode.
+struct LaneAxis<L: Lanes> {
+    coord: L::F32,
+}
+
+impl<L: Lanes> LaneAxis<L> {
+    /// `t` (texture coordinate) times the level size `size`, after [`Wrap`]'s reduction: in
+    /// `[0, size]` for REPEAT, `[0, 2·size]` for MIRRORED_REPEAT, and limited to
+    /// `[−2, size + 2]` for CLAMP_TO_EDGE (which changes no texel or weight that is read, and
+    /// keeps the conversion to `i32` in range).
+    #[inline(always)]
+    fn new(wrap: Wrap, t: L::F32, size: L::I32) -> Self {
+        let lanes = t.lanes();
+        let size = size.to_f32();
+        let coord = match wrap {
+            Wrap::Repeat => (t - t.floor()) * size,
+            Wrap::MirroredRepeat => {
+                (t - lanes.splat_f32(2.0) * (t * lanes.splat_f32(0.5)).floor()) * size
+            }
+            Wrap::ClampToEdge => (t * size)
+                .max(lanes.splat_f32(-2.0))
+                .min(size + lanes.splat_f32(2.0)),
+        };
+        Self { coord }
+    }
+}
+
+impl Wrap {
+    /// [`Wrap::apply`] on lanes, for the integer coordinates [`LaneAxis`] produces: in
+    /// `[−1, size]` for REPEAT, `[−1, 2·size]` for MIRRORED_REPEAT, anything for CLAMP_TO_EDGE.
+    #[inline(always)]
+    fn wrap_lanes<L: Lanes>(self, i: L::I32, size: L::I32) -> L::I32 {
+        let lanes = i.lanes();
+        let zero = lanes.splat_i32(0);
+        let one = lanes.splat_i32(1);
+        match self {
+            Wrap::Repeat => {
+                let i = i.simd_lt(zero).select_i32(i + size, i);
+                i.simd_gt(size - one).select_i32(i - size, i)
+            }
+            Wrap::ClampToEdge => i.max(zero).min(size - one),
+            Wrap::MirroredRepeat => {
+                let period = size + size;
+                let p = i.simd_lt(zero).select_i32(i + period, i);
+                let p = p.simd_gt(period - one).select_i32(p - period, p);
+                p.simd_lt(size).select_i32(p, period - one - p)
+            }
+        }
+    }
+}
+
+/// `x² + y²` of a derivative `[∂u, ∂v]` scaled to texels (`width`, `height`).
+#[inline(always)]
+fn footprint2<L: Lanes>(d: [L::F32; 2], width: L::F32, height: L::F32) -> L::F32 {
+    let (x, y) = (d[0] * width, d[1] * height);
+    x * x + y * y
+}
+
+/// `log2 x` for positive normal `x`, from the exponent bits and a polynomial in
+/// `s = (m − 1)/(m + 1)` with the mantissa `m` in `[√½, √2)`: `log2 m = (2/ln 2)·atanh s`, the
+/// series to `s⁹` (truncation below 2e-9 for `|s| ≤ 0.172`). Other inputs give unspecified values.
+#[inline(always)]
+pub(super) fn log2_normal<L: Lanes>(x: L::F32) -> L::F32 {
+    let lanes = x.lanes();
+    let bits = x.to_bits();
+    let exponent = bits.shr_logical::<23>() - lanes.splat_i32(127);
+    let mantissa_bits = (bits & lanes.splat_i32(0x007f_ffff)) | lanes.splat_i32(0x3f80_0000);
+    let m = L::F32::from_bits(mantissa_bits);
+    // m in [1, 2): above √2, halve it (exact) and raise the exponent.
+    let high = m.simd_ge(lanes.splat_f32(std::f32::consts::SQRT_2));
+    let m = high.select_f32(m * lanes.splat_f32(0.5), m);
+    let exponent = high.select_i32(exponent + lanes.splat_i32(1), exponent);
+    let one = lanes.splat_f32(1.0);
+    let s = (m - one) / (m + one);
+    let s2 = s * s;
+    // 2 / ((2k + 1) ln 2) for k = 0..5.
+    const TWO_LOG2_E: f32 = 2.0 * std::f32::consts::LOG2_E;
+    const C: [f32; 5] = [
+        TWO_LOG2_E,
+        TWO_LOG2_E / 3.0,
+        TWO_LOG2_E / 5.0,
+        TWO_LOG2_E / 7.0,
+        TWO_LOG2_E / 9.0,
+    ];
+    let (c1, c3, c5) = (
+        lanes.splat_f32(C[0]),
+        lanes.splat_f32(C[1]),
+        lanes.splat_f32(C[2]),
+    );
+    let (c7, c9) = (lanes.splat_f32(C[3]), lanes.splat_f32(C[4]));
+    let poly = c1 + s2 * (c3 + s2 * (c5 + s2 * (c7 + s2 * c9)));
+    exponent.to_f32() + s * poly
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Vec2, Vec4};
+
+    use super::*;
+    use crate::simd::{dispatch, Isa, LaneKernel};
+
+    /// Eight samples: uv and its derivatives per lane.
+    #[derive(Clone, Copy, Debug)]
+    struct Query {
+        uv: [Vec2; 8],
+        duv_dx: [Vec2; 8],
+        duv_dy: [Vec2; 8],
+        active: u8,
+    }
+
+    struct Sample<'a> {
+        texture: &'a Texture,
+        sampler: Sampler,
+        query: Query,
+    }
+
+    impl LaneKernel for Sample<'_> {
+        type Output = [[f32; 8]; 4];
+        #[inline(always)]
+        fn run<L: Lanes>(self, lanes: L) -> [[f32; 8]; 4] {
+            let q = self.query;
+            let pair = |v: [Vec2; 8]| {
+                [
+                    lanes.f32_from_array(v.map(|p| p.x)),
+                    lanes.f32_from_array(v.map(|p| p.y)),
+                ]
+            };
+            self.texture
+                .sample_grad_lanes::<L>(
+                    &self.sampler,
+                    pair(q.uv),
+                    pair(q.duv_dx),
+                    pair(q.duv_dy),
+                    lanes.mask_from_bits(q.active),
+                )
+                .map(F32x8::to_array)
+        }
+    }
+
+    struct Log2([f32; 8]);
+
+    impl LaneKernel for Log2 {
+        type Output = [f32; 8];
+        #[inline(always)]
+        fn run<L: Lanes>(self, lanes: L) -> [f32; 8] {
+            log2_normal::<L>(lanes.f32_from_array(self.0)).to_array()
+        }
+    }
+
+    /// A small deterministic generator (xorshift).
+    struct Rng(u32);
+
+    impl Rng {
+        fn next(&mut self) -> u32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 17;
+            self.0 ^= self.0 << 5;
+            self.0
+        }
+        /// Uniform in [lo, hi).
+        fn range(&mut self, lo: f32, hi: f32) -> f32 {
+            lo + (hi - lo) * (self.next() >> 8) as f32 / (1 << 24) as f32
+        }
+    }
+
+    fn noise_texture(width: u32, height: u32, color_space: ColorSpace) -> Texture {
+        let mut rng = Rng(0x1234_5678);
+        let rgba: Vec<u8> = (0..width * height * 4).map(|_| rng.next() as u8).collect();
+        Texture::from_rgba8(width, height, &rgba, color_space).expect("texture")
+    }
+
+    fn supported_isas() -> Vec<Isa> {
+        Isa::ALL.into_iter().filter(|i| i.is_supported()).collect()
+    }
+
+    const WRAPS: [Wrap; 3] = [Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat];
+    const MIN_FILTERS: [MinFilter; 6] = [
+        MinFilter::Nearest,
+        MinFilter::Linear,
+        MinFilter::NearestMipmapNearest,
+        MinFilter::LinearMipmapNearest,
+        MinFilter::NearestMipmapLinear,
+        MinFilter::LinearMipmapLinear,
+    ];
+
+    fn samplers() -> impl Iterator<Item = Sampler> {
+        WRAPS.into_iter().flat_map(|wrap_s| {
+            WRAPS.into_iter().flat_map(move |wrap_t| {
+                [Filter::Nearest, Filter::Linear]
+                    .into_iter()
+                    .flat_map(move |mag_filter| {
+                        MIN_FILTERS.into_iter().map(move |min_filter| Sampler {
+                            wrap_s,
+                            wrap_t,
+                            mag_filter,
+                            min_filter,
+                        })
+                    })
+            })
+        })
+    }
+
+    /// Random queries: coordinates around and beyond [0, 1], footprints from magnified to
+    /// beyond the last level, anisotropic.
+    fn queries(rng: &mut Rng, count: usize) -> Vec<Query> {
+        (0..count)
+            .map(|_| {
+                let mut uv = [Vec2::ZERO; 8];
+                let mut duv_dx = [Vec2::ZERO; 8];
+                let mut duv_dy = [Vec2::ZERO; 8];
+                for k in 0..8 {
+                    uv[k] = Vec2::new(rng.range(-3.0, 3.0), rng.range(-3.0, 3.0));
+                    let scale = 2f32.powf(rng.range(-12.0, 2.0));
+                    duv_dx[k] = Vec2::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * scale;
+                    duv_dy[k] = Vec2::new(rng.range(-1.0, 1.0), rng.range(-1.0, 1.0)) * scale;
+                }
+                // Half the rows share one footprint (one level for all lanes, as in a typical
+                // row of pixels), half have one per lane.
+                if rng.next() % 2 == 0 {
+                    duv_dx = [duv_dx[0]; 8];
+                    duv_dy = [duv_dy[0]; 8];
+                }
+                Query {
+                    uv,
+                    duv_dx,
+                    duv_dy,
+                    active: rng.next() as u8 | 1,
+                }
+            })
+            .collect()
+    }
+
+    fn scalar_reference(texture: &Texture, sampler: &Sampler, q: &Query, k: usize) -> Vec4 {
+        texture.sample_grad(sampler, q.uv[k], q.duv_dx[k], q.duv_dy[k])
+    }
+
+    #[test]
+    fn log2_polynomial_is_close_to_libm() {
+        let mut rng = Rng(99);
+        let isas = supported_isas();
+        for _ in 0..2000 {
+            let x: [f32; 8] = std::array::from_fn(|_| 2f32.powf(rng.range(-126.0, 127.0)));
+            let reference = dispatch(Isa::Scalar, Log2(x));
+            for &isa in &isas {
+                let got = dispatch(isa, Log2(x));
+                assert_eq!(got.map(f32::to_bits), reference.map(f32::to_bits), "{isa}");
+            }
+            for k in 0..8 {
+                let exact = (x[k] as f64).log2();
+                let error = (reference[k] as f64 - exact).abs();
+                assert!(
+                    error < 2e-6 + exact.abs() * 1e-7,
+                    "log2 {} = {}",
+                    x[k],
+                    reference[k]
+                );
+            }
+        }
+        for (x, expected) in [(1.0f32, 0.0f32), (2.0, 1.0), (0.5, -1.0), (1024.0, 10.0)] {
+            assert_eq!(dispatch(Isa::Scalar, Log2([x; 8]))[0], expected);
+        }
+    }
+
+    #[test]
+    fn lanes_agree_with_the_scalar_sampler_for_every_wrap_and_filter() {
+        let mut rng = Rng(7);
+        let isas = supported_isas();
+        for (texture, tolerance) in [
+            (noise_texture(16, 8, ColorSpace::Srgb), 2e-5),
+            (noise_texture(5, 3, ColorSpace::Linear), 2e-5),
+            (noise_texture(1, 1, ColorSpace::Srgb), 2e-5),
+        ] {
+            for sampler in samplers() {
+                for query in queries(&mut rng, 12) {
+                    let kernel = || Sample {
+                        texture: &texture,
+                        sampler,
+                        query,
+                    };
+                    let lanes = dispatch(Isa::Scalar, kernel());
+                    for &isa in &isas {
+                        let got = dispatch(isa, kernel());
+                        assert!(
+                            got.map(|c| c.map(f32::to_bits)) == lanes.map(|c| c.map(f32::to_bits)),
+                            "{isa} differs from scalar lanes: {sampler:?} {query:?}"
+                        );
+                    }
+                    for k in (0..8).filter(|k| query.active & (1 << k) != 0) {
+                        let expected = scalar_reference(&texture, &sampler, &query, k);
+                        let got = Vec4::new(lanes[0][k], lanes[1][k], lanes[2][k], lanes[3][k]);
+                        // Where λ sits on a level boundary the two may pick neighbouring
+                        // levels; compare against both sides of the boundary then.
+                        let close = (got - expected).abs().max_element() <= tolerance;
+                        let lod = texture.lod(query.duv_dx[k], query.duv_dy[k]);
+                        let near_boundary = (lod - lod.round()).abs() < 1e-4
+                            || (lod + 0.5 - (lod + 0.5).round()).abs() < 1e-4;
+                        let either_side = near_boundary
+                            && [lod - 2e-4, lod + 2e-4].into_iter().any(|l| {
+                                let e = texture.sample_lod(&sampler, query.uv[k], l);
+                                (got - e).abs().max_element() <= 1e-3
+                            });
+                        assert!(
+                            close || either_side,
+                            "lane {k}: {got} vs scalar {expected} (λ {lod}), {sampler:?} {query:?}"
+                        );
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn nan_and_huge_coordinates_are_defined() {
+        let texture = noise_texture(8, 8, ColorSpace::Srgb);
+        let big = [
+            1e30f32,
+            -1e30,
+            3e38,
+            -3e38,
+            8_388_609.0,
+            -16_777_217.0,
+            1e9,
+            0.5,
+        ];
+        let mut uv = big.map(|x| Vec2::new(x, 0.25));
+        uv[7] = Vec2::new(f32::NAN, 0.5);
+        uv[6] = Vec2::new(0.5, f32::INFINITY);
+        let query = Query {
+            uv,
+            duv_dx: [Vec2::new(f32::NAN, 0.0); 8],
+            duv_dy: [Vec2::new(0.0, f32::INFINITY); 8],
+            active: 0xff,
+        };
+        for sampler in samplers() {
+            for isa in supported_isas() {
+                let got = dispatch(
+                    isa,
+                    Sample {
+                        texture: &texture,
+                        sampler,
+                        query,
+                    },
+                );
+                for (k, uv) in query.uv.iter().enumerate() {
+                    let texel = Vec4::new(got[0][k], got[1][k], got[2][k], got[3][k]);
+                    let expected = scalar_reference(&texture, &sampler, &query, k);
+                    assert!(texel.is_finite(), "{isa} lane {k} at {uv}: {texel}");
+                    assert!(
+                        (texel - expected).abs().max_element() <= 2e-5,
+                        "{isa} lane {k}: {texel} vs {expected}, {sampler:?}"
+                    );
+                }
+                assert_eq!([got[0][7], got[3][7], got[0][6], got[3][6]], [0.0; 4]);
+            }
+        }
+    }
+
+    #[test]
+    fn inactive_lanes_are_not_sampled() {
+        let texture = noise_texture(4, 4, ColorSpace::Linear);
+        let query = Query {
+            uv: [Vec2::splat(0.5); 8],
+            duv_dx: [Vec2::ZERO; 8],
+            duv_dy: [Vec2::ZERO; 8],
+            active: 0,
+        };
+        let got = dispatch(
+            Isa::Scalar,
+            Sample {
+                texture: &texture,
+                sampler: Sampler::default(),
+                query,
+            },
+        );
+        assert_eq!(got, [[0.0; 8]; 4]);
+    }
+}
