@@ -1,0 +1,280 @@
+//! No silent blanks at extreme scales: clipping that keeps its precision (tiny models, huge
+//! ground planes, triangles reaching far past the guard band), and the frame-level guards
+//! (NaN colours and samples, time budgets, empty-picture warning, streaming readback).
+
+use glam::{Mat4, Vec3, Vec4};
+use kantele::camera::{look_at, perspective};
+use kantele::pipeline::{FnShader, Fragment, Indices, RenderState, Renderer, RendererOptions};
+use kantele::setup::CullMode;
+
+/// A shader whose vertices are clip-space positions already and which paints opaque white.
+fn clip_space_shader() -> impl kantele::pipeline::Shader<Vertex = Vec4> {
+    FnShader::new(
+        0,
+        |v: &Vec4, _out: &mut [f32]| *v,
+        |_f: &Fragment<'_>| Some(Vec4::ONE),
+    )
+}
+
+fn no_cull() -> RenderState {
+    RenderState {
+        cull: CullMode::None,
+        ..RenderState::default()
+    }
+}
+
+/// Renders clip-space triangles (white on transparent black); returns the renderer and stats.
+fn render_clip(size: (u32, u32), vertices: &[Vec4]) -> (Renderer, kantele::stats::FrameStats) {
+    let shader = clip_space_shader();
+    let mut renderer = Renderer::new(size.0, size.1, RendererOptions::default()).expect("renderer");
+    let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
+    frame
+        .draw(&shader, vertices, Indices::None, no_cull())
+        .expect("draw");
+    let stats = frame.end();
+    (renderer, stats)
+}
+
+/// Which pixels were written (alpha > 0), row-major, row 0 at the top.
+fn coverage(renderer: &Renderer) -> Vec<bool> {
+    renderer
+        .framebuffer()
+        .read_color()
+        .iter()
+        .map(|c| c[3] > 0.0)
+        .collect()
+}
+
+/// A few triangles of a model seen through `view_proj`: a box's faces.
+fn box_triangles(view_proj: Mat4, half: f32) -> Vec<Vec4> {
+    let corner = |i: u32| {
+        Vec3::new(
+            if i & 1 == 0 { -half } else { half },
+            if i & 2 == 0 { -half } else { half },
+            if i & 4 == 0 { -half } else { half },
+        )
+    };
+    let faces = [
+        [0, 1, 3, 2],
+        [4, 6, 7, 5],
+        [0, 4, 5, 1],
+        [2, 3, 7, 6],
+        [0, 2, 6, 4],
+        [1, 5, 7, 3],
+    ];
+    let mut out = Vec::new();
+    for f in faces {
+        for k in [0, 1, 2, 0, 2, 3] {
+            out.push(view_proj * corner(f[k]).extend(1.0));
+        }
+    }
+    out
+}
+
+#[test]
+fn a_model_scaled_by_a_power_of_two_renders_bit_identically_down_to_1e_minus_9() {
+    let view_proj =
+        perspective(0.8, 1.0, 0.5, 50.0) * look_at(Vec3::new(1.3, 0.9, 2.0), Vec3::ZERO, Vec3::Y);
+    let unit = box_triangles(view_proj, 1.0);
+    let (reference, _) = render_clip((96, 96), &unit);
+    let expected = coverage(&reference);
+    assert!(expected.iter().filter(|&&c| c).count() > 500);
+    // Scaling every clip coordinate by s is what scaling the model and the camera (eye, near
+    // and far) by s does; with s a power of two, x/w, y/w and z/w keep their bits.
+    for exponent in [-30, -60, -100] {
+        let s = 2.0f32.powi(exponent);
+        let scaled: Vec<Vec4> = unit.iter().map(|&p| p * s).collect();
+        let (renderer, stats) = render_clip((96, 96), &scaled);
+        assert_eq!(coverage(&renderer), expected, "scale 2^{exponent}");
+        assert_eq!(stats.triangles_invalid, 0);
+    }
+}
+
+#[test]
+fn a_1e_minus_9_model_with_a_1e_minus_9_camera_renders_like_the_unit_model() {
+    let picture = |s: f32| {
+        let view_proj = perspective(0.8, 1.0, 0.5 * s, 50.0 * s)
+            * look_at(Vec3::new(1.3, 0.9, 2.0) * s, Vec3::ZERO, Vec3::Y);
+        let (renderer, _) = render_clip((96, 96), &box_triangles(view_proj, s));
+        coverage(&renderer)
+    };
+    let unit = picture(1.0);
+    let tiny = picture(1e-9);
+    let covered = unit.iter().filter(|&&c| c).count();
+    let differing = unit.iter().zip(&tiny).filter(|(a, b)| a != b).count();
+    assert!(covered > 500);
+    // f32 rounding of the matrices differs at the two scales: edge pixels may flip, no more.
+    assert!(
+        differing <= covered / 100,
+        "{differing} of {covered} pixels differ"
+    );
+}
+
+/// Renders the square `[−e, e]²` of the plane y = 0 seen from `eye` towards `target` and
+/// checks every pixel against the exact ray–plane intersection (pixels whose ray is within
+/// 1e-4 of grazing are skipped: that is where the finite plane ends).
+fn check_ground_plane(size: (u32, u32), eye: Vec3, target: Vec3, e: f32) {
+    let (w, h) = size;
+    let view_proj = perspective(1.2, w as f32 / h as f32, 0.1, 1e7) * look_at(eye, target, Vec3::Y);
+    let corners = [
+        Vec3::new(-e, 0.0, -e),
+        Vec3::new(e, 0.0, -e),
+        Vec3::new(e, 0.0, e),
+        Vec3::new(-e, 0.0, e),
+    ];
+    let clip: Vec<Vec4> = [0, 1, 2, 0, 2, 3]
+        .iter()
+        .map(|&i| view_proj * corners[i].extend(1.0))
+        .collect();
+    let (renderer, stats) = render_clip((w, h), &clip);
+    assert!(stats.triangles_clipped > 0);
+    let covered = coverage(&renderer);
+    let inverse = view_proj.as_dmat4().inverse();
+    let (mut wrong, mut checked) = (0, 0);
+    for y in 0..h {
+        for x in 0..w {
+            let x_ndc = (x as f64 + 0.5) / w as f64 * 2.0 - 1.0;
+            let y_ndc = 1.0 - (y as f64 + 0.5) / h as f64 * 2.0;
+            let near = inverse.project_point3(glam::DVec3::new(x_ndc, y_ndc, -1.0));
+            let far = inverse.project_point3(glam::DVec3::new(x_ndc, y_ndc, 0.0));
+            let direction = (far - near).normalize();
+            if direction.y.abs() < 1e-4 {
+                continue;
+            }
+            let t = -near.y / direction.y;
+            let hit = near + direction * t;
+            let expected = t > 0.0 && hit.x.abs() < e as f64 && hit.z.abs() < e as f64;
+            checked += 1;
+            if covered[(y * w + x) as usize] != expected {
+                wrong += 1;
+            }
+        }
+    }
+    assert!(checked > (w * h) as usize * 9 / 10);
+    assert_eq!(wrong, 0, "{wrong} of {checked} pixels wrong");
+}
+
+#[test]
+fn a_1e6_ground_plane_through_the_near_plane_covers_exactly_the_screen_below_the_horizon() {
+    let e = 1e6;
+    check_ground_plane(
+        (128, 96),
+        Vec3::new(0.0, 1.0, 0.0),
+        Vec3::new(0.0, 1.0, -1.0),
+        e,
+    );
+    check_ground_plane(
+        (160, 120),
+        Vec3::new(0.3, 1.7, 0.2),
+        Vec3::new(2.0, 0.0, -5.0),
+        e,
+    );
+    check_ground_plane(
+        (160, 120),
+        Vec3::new(10.0, 3.0, -7.0),
+        Vec3::new(-3.0, 2.0, 5.0),
+        e,
+    );
+    check_ground_plane(
+        (400, 300),
+        Vec3::new(0.0, 1.7, 0.0),
+        Vec3::new(0.0, 0.0, -3.0),
+        e,
+    );
+    check_ground_plane(
+        (400, 300),
+        Vec3::new(5.0, 0.3, 9.0),
+        Vec3::new(4.0, 0.0, 7.0),
+        e,
+    );
+}
+
+/// A triangle whose edge from `(−r, −m·r)` to `(r, m·r)` (clip space, w = 1) crosses the
+/// target through its centre, the rest of it far outside: it must cover exactly the pixel
+/// centres above that line.
+fn check_far_reaching_triangle(r: f32, m: f32) {
+    let (w, h) = (160u32, 120u32);
+    let y_far = m * r;
+    let tri = [
+        Vec4::new(-r, -y_far, 0.0, 1.0),
+        Vec4::new(r, y_far, 0.0, 1.0),
+        Vec4::new(-r, r, 0.0, 1.0),
+    ];
+    let (renderer, stats) = render_clip((w, h), &tri);
+    assert_eq!(stats.triangles_clipped, 1);
+    let covered = coverage(&renderer);
+    // The exact line through the f32 vertices (symmetric, so through the origin).
+    let slope = y_far as f64 / r as f64;
+    let mut checked = 0;
+    for y in 0..h {
+        for x in 0..w {
+            let x_ndc = (x as f64 + 0.5) / w as f64 * 2.0 - 1.0;
+            let y_ndc = 1.0 - (y as f64 + 0.5) / h as f64 * 2.0;
+            let above = y_ndc - slope * x_ndc;
+            // Distance from the edge in pixels (vertical); skip near-ties within 1/16 pixel.
+            if (above * h as f64 / 2.0).abs() < 1.0 / 16.0 {
+                continue;
+            }
+            checked += 1;
+            assert_eq!(
+                covered[(y * w + x) as usize],
+                above > 0.0,
+                "r = {r:e}: pixel ({x}, {y})"
+            );
+        }
+    }
+    assert!(checked > (w * h) as usize * 9 / 10);
+}
+
+#[test]
+fn triangles_reaching_1e9_and_1e12_past_the_target_cover_exactly_their_pixels() {
+    for r in [1e6, 1e9, 1e12] {
+        check_far_reaching_triangle(r, 0.37);
+        check_far_reaching_triangle(r, -0.61);
+    }
+}
+
+#[test]
+fn clipping_never_hands_setup_a_vertex_with_w_at_or_below_zero() {
+    use kantele::geometry::clip::{ClipPolygon, ClipVertex, GuardBand, W_MIN};
+    let guard = GuardBand::new(200, 100);
+    let vertex = |x: f32, y: f32, z: f32, w: f32| ClipVertex {
+        pos_clip: Vec4::new(x, y, z, w),
+        varyings: [0.0; kantele::MAX_VARYINGS],
+    };
+    // Triangles crossing w = 0 at every scale, some through the eye itself.
+    for scale in [1e-30f32, 1e-9, 1.0, 1e6, 1e20] {
+        for (a, b, c) in [
+            (
+                (0.0, 0.0, 0.0, 0.0),
+                (1.0, 0.5, 2.0, 3.0),
+                (-1.0, 0.5, 2.0, 3.0),
+            ),
+            (
+                (3.0, 1.0, -5.0, -4.0),
+                (1.0, 0.0, 1.0, 2.0),
+                (0.0, 1.0, 1.0, 2.0),
+            ),
+            (
+                (1e6, 0.0, 0.0, 1e-3),
+                (-1e6, 3.0, 0.0, -1.0),
+                (0.0, -1.0, 0.5, 1.0),
+            ),
+        ] {
+            let v = |p: (f32, f32, f32, f32)| {
+                vertex(p.0 * scale, p.1 * scale, p.2 * scale, p.3 * scale)
+            };
+            let mut poly = ClipPolygon::triangle(v(a), v(b), v(c));
+            poly.clip(&guard, 0);
+            for v in poly.vertices() {
+                assert!(v.pos_clip.is_finite());
+                assert!(
+                    v.pos_clip.w >= W_MIN,
+                    "scale {scale:e}: w = {}",
+                    v.pos_clip.w
+                );
+                assert!(v.pos_clip.z >= -v.pos_clip.w * (1.0 + 1e-6));
+            }
+        }
+    }
+}
