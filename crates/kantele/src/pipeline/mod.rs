@@ -243,6 +243,7 @@ impl<'a> Frame<'_, 'a> {
                 fragment::raster_tiles(framebuffer, bins, geometry, &draws, strategy, isa);
             stats.fragments_covered = counters.covered;
             stats.tiles_depth_rejected = counters.tile_rejected;
+            stats.blocks_depth_rejected = counters.blocks_rejected;
             stats.fragments_shaded = counters.shaded;
             stats.fragments_discarded = counters.discarded;
             stats.raster_time = raster_start.elapsed();
