@@ -278,3 +278,198 @@ fn clipping_never_hands_setup_a_vertex_with_w_at_or_below_zero() {
         }
     }
 }
+
+/// Two clip-space triangles covering the whole target at depth 0.
+fn full_screen_quad() -> Vec<Vec4> {
+    let v = |x: f32, y: f32| Vec4::new(x, y, 0.0, 1.0);
+    vec![
+        v(-1.0, -1.0),
+        v(1.0, -1.0),
+        v(1.0, 1.0),
+        v(-1.0, -1.0),
+        v(1.0, 1.0),
+        v(-1.0, 1.0),
+    ]
+}
+
+#[test]
+fn nan_colour_channels_are_written_as_zero_and_counted() {
+    let shader = FnShader::new(
+        0,
+        |v: &Vec4, _out: &mut [f32]| *v,
+        |_f: &Fragment<'_>| Some(Vec4::new(f32::NAN, 0.5, -f32::NAN, 1.0)),
+    );
+    let quad = full_screen_quad();
+    let mut renderer = Renderer::new(40, 24, RendererOptions::default()).expect("renderer");
+    let mut frame = renderer.begin_frame(Some(Vec4::splat(0.25)), Some(1.0));
+    frame
+        .draw(&shader, &quad, Indices::None, no_cull())
+        .expect("draw");
+    let stats = frame.end();
+    assert_eq!(stats.fragments_covered, 40 * 24);
+    assert_eq!(stats.nan_color_channels, 2 * 40 * 24);
+    for c in renderer.framebuffer().read_color() {
+        assert_eq!(c, [0.0, 0.5, 0.0, 1.0]);
+    }
+
+    // Blending infinities makes NaN too (∞ · 0): also written as 0 and counted.
+    let infinite = FnShader::new(
+        0,
+        |v: &Vec4, _out: &mut [f32]| *v,
+        |_f: &Fragment<'_>| Some(Vec4::new(f32::INFINITY, 0.5, 0.5, 0.0)),
+    );
+    let mut frame = renderer.begin_frame(Some(Vec4::splat(0.25)), Some(1.0));
+    let blend = RenderState {
+        blend: kantele::rop::BlendMode::Alpha,
+        ..no_cull()
+    };
+    frame
+        .draw(&infinite, &quad, Indices::None, blend)
+        .expect("draw");
+    let stats = frame.end();
+    assert_eq!(stats.nan_color_channels, 40 * 24);
+    for c in renderer.framebuffer().read_color() {
+        assert!(c.iter().all(|v| !v.is_nan()), "{c:?}");
+        assert_eq!(c[0], 0.0);
+    }
+}
+
+#[test]
+fn texture_samples_at_nan_and_huge_coordinates_are_defined() {
+    use kantele::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
+    let texels: Vec<Vec4> = (0..16)
+        .map(|i| Vec4::new(i as f32, 1.0, 2.0, 1.0))
+        .collect();
+    let texture = Texture::from_rgba_f32(4, 4, texels).expect("texture");
+    let coordinates = [
+        f32::NAN,
+        f32::INFINITY,
+        -f32::INFINITY,
+        1e38,
+        -1e38,
+        3e9,
+        0.5,
+    ];
+    for wrap in [Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat] {
+        for filter in [Filter::Nearest, Filter::Linear] {
+            let sampler = Sampler {
+                wrap_s: wrap,
+                wrap_t: wrap,
+                mag_filter: filter,
+                min_filter: MinFilter::Linear,
+            };
+            for &u in &coordinates {
+                for &v in &coordinates {
+                    let s = texture.sample_lod(&sampler, glam::Vec2::new(u, v), 0.0);
+                    assert!(s.is_finite(), "{wrap:?} {filter:?} at ({u}, {v}): {s}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_frame_of_a_million_full_screen_triangles_stops_at_its_time_budget() {
+    use std::time::{Duration, Instant};
+    let quad = full_screen_quad();
+    let indices: Vec<u32> = (0..1_000_000u32).flat_map(|_| [0, 1, 2]).collect();
+    let budget = Duration::from_millis(50);
+    let shader = clip_space_shader();
+    let mut renderer = Renderer::new(
+        256,
+        256,
+        RendererOptions {
+            timeout: Some(budget),
+            ..RendererOptions::default()
+        },
+    )
+    .expect("renderer");
+    let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
+    let state = RenderState {
+        depth_test: false,
+        ..no_cull()
+    };
+    frame
+        .draw(&shader, &quad, Indices::U32(&indices), state)
+        .expect("draw");
+    let start = Instant::now();
+    let result = frame.try_end();
+    let elapsed = start.elapsed();
+    assert_eq!(result, Err(kantele::RenderError::TimedOut { budget }));
+    // About twice the budget on an idle machine; generous for a loaded CI runner.
+    assert!(elapsed < budget * 5, "stopped after {elapsed:?}");
+    eprintln!("a 50 ms budget stopped the frame after {elapsed:?}");
+
+    // The stats say so too, and the error names the budget.
+    let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
+    frame
+        .draw(&shader, &quad, Indices::U32(&indices), state)
+        .expect("draw");
+    let stats = frame.end();
+    assert_eq!(
+        stats.stopped,
+        Some(kantele::stats::FrameStop::TimedOut { budget })
+    );
+    assert!(!stats.empty_picture);
+    assert_eq!(
+        kantele::RenderError::TimedOut { budget }.to_string(),
+        "frame stopped after its time budget of 50 ms"
+    );
+}
+
+#[test]
+fn a_raised_cancel_flag_stops_the_frame_and_a_lowered_one_lets_it_finish() {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::Arc;
+    let quad = full_screen_quad();
+    let shader = clip_space_shader();
+    let mut renderer = Renderer::new(64, 64, RendererOptions::default()).expect("renderer");
+    let flag = Arc::new(AtomicBool::new(true));
+    renderer.set_cancel_flag(Some(flag.clone()));
+    let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
+    frame
+        .draw(&shader, &quad, Indices::None, no_cull())
+        .expect("draw");
+    assert_eq!(frame.try_end(), Err(kantele::RenderError::Cancelled));
+
+    flag.store(false, Ordering::Relaxed);
+    let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
+    frame
+        .draw(&shader, &quad, Indices::None, no_cull())
+        .expect("draw");
+    let stats = frame.try_end().expect("not cancelled");
+    assert_eq!(stats.fragments_covered, 64 * 64);
+    assert_eq!(stats.stopped, None);
+}
+
+#[test]
+fn an_empty_picture_with_geometry_in_view_is_flagged_and_an_empty_scene_is_not() {
+    let quad = full_screen_quad();
+    let shader = clip_space_shader();
+    let mut renderer = Renderer::new(32, 32, RendererOptions::default()).expect("renderer");
+    let frame_stats = |renderer: &mut Renderer, vertices: &[Vec4], state: RenderState| {
+        let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
+        frame
+            .draw(&shader, vertices, Indices::None, state)
+            .expect("draw");
+        frame.end()
+    };
+    // Everything back-facing and culled: in view, but nothing drawn.
+    let clockwise: Vec<Vec4> = quad.chunks(3).flat_map(|t| [t[0], t[2], t[1]]).collect();
+    let culled = frame_stats(&mut renderer, &clockwise, RenderState::default());
+    assert!(culled.empty_picture);
+    let warning = culled.empty_picture_warning().expect("warning");
+    assert!(warning.contains("2 of 2 triangles"), "{warning}");
+    assert!(warning.contains("2 culled"), "{warning}");
+    // Drawn: no warning.
+    let drawn = frame_stats(&mut renderer, &quad, no_cull());
+    assert!(!drawn.empty_picture);
+    assert_eq!(drawn.empty_picture_warning(), None);
+    // Wholly outside the view volume, or no triangles at all: empty for an obvious reason.
+    let behind: Vec<Vec4> = quad
+        .iter()
+        .map(|p| Vec4::new(p.x, p.y, -5.0, 1.0))
+        .collect();
+    assert!(!frame_stats(&mut renderer, &behind, no_cull()).empty_picture);
+    assert!(!frame_stats(&mut renderer, &[], no_cull()).empty_picture);
+}

@@ -5,6 +5,7 @@
 use glam::Vec4;
 use rayon::prelude::*;
 
+use super::budget::FrameBudget;
 use super::draw::DrawJob;
 use crate::geometry::clip::GuardBand;
 use crate::setup::{TriangleSetup, Viewport};
@@ -110,6 +111,7 @@ pub(super) fn run_geometry(
     viewport: &Viewport,
     stats: &mut FrameStats,
     scratch: &mut GeometryScratch,
+    budget: &FrameBudget<'_>,
 ) {
     let GeometryScratch {
         shaded,
@@ -147,8 +149,18 @@ pub(super) fn run_geometry(
     }
     vertex_jobs
         .into_par_iter()
-        .for_each(|(draw, first, pos, vary)| draws[draw].shade_vertices(first, pos, vary));
+        .for_each(|(draw, first, pos, vary)| {
+            // Budget: a chunk at a time (robust branch).
+            if !budget.exhausted() {
+                draws[draw].shade_vertices(first, pos, vary);
+            }
+        });
     let shaded = &*shaded;
+    if budget.exhausted() {
+        output.triangles.clear();
+        output.attrs.clear();
+        return;
+    }
 
     // 2. Primitive stage over all draws, in chunks; results concatenated in order.
     let mut primitive_jobs = Vec::new();
@@ -179,6 +191,10 @@ pub(super) fn run_geometry(
         .zip(primitive_jobs.par_iter())
         .for_each(|(batch, &(draw, first, last))| {
             batch.clear();
+            // Budget: a chunk at a time (robust branch).
+            if budget.exhausted() {
+                return;
+            }
             draws[draw].assemble(
                 draw as u32,
                 first..last,
@@ -191,6 +207,9 @@ pub(super) fn run_geometry(
 
     output.triangles.clear();
     output.attrs.clear();
+    if budget.exhausted() {
+        return;
+    }
     output.draw_first.clear();
     output.draw_first.resize(draws.len(), (0, 0));
     output
