@@ -473,3 +473,68 @@ fn an_empty_picture_with_geometry_in_view_is_flagged_and_an_empty_scene_is_not()
     assert!(!frame_stats(&mut renderer, &behind, no_cull()).empty_picture);
     assert!(!frame_stats(&mut renderer, &[], no_cull()).empty_picture);
 }
+
+#[test]
+fn row_streaming_readback_gives_the_whole_frame_readback_row_by_row() {
+    // An odd size: partial tiles on the right and at the bottom.
+    let (w, h) = (130u32, 70u32);
+    let shader = FnShader::new(
+        0,
+        |v: &Vec4, _out: &mut [f32]| *v,
+        |f: &Fragment<'_>| Some(Vec4::new(f.x as f32 / 130.0, f.y as f32 / 70.0, 0.25, 1.0)),
+    );
+    let tri = [
+        Vec4::new(-0.9, -0.8, 0.3, 1.0),
+        Vec4::new(0.95, -0.2, -0.4, 1.0),
+        Vec4::new(-0.1, 0.9, 0.1, 1.0),
+    ];
+    let mut renderer = Renderer::new(w, h, RendererOptions::default()).expect("renderer");
+    let mut frame = renderer.begin_frame(Some(Vec4::new(0.1, 0.2, 0.3, 0.4)), Some(1.0));
+    frame
+        .draw(&shader, &tri, Indices::None, no_cull())
+        .expect("draw");
+    frame.end();
+    let fb = renderer.framebuffer();
+
+    let rgba8 = fb.read_rgba8(true);
+    assert_eq!(rgba8.len(), (w * h * 4) as usize);
+    assert_eq!(rgba8.capacity(), rgba8.len(), "one exact allocation");
+    let mut next = 0;
+    fb.read_rgba8_rows(true, |y, row| {
+        assert_eq!(y, next);
+        assert_eq!(row.len(), (w * 4) as usize);
+        assert_eq!(
+            row,
+            &rgba8[(y * w * 4) as usize..((y + 1) * w * 4) as usize]
+        );
+        next += 1;
+    });
+    assert_eq!(next, h);
+
+    let color = fb.read_color();
+    let depth = fb.read_depth();
+    let (mut color_rows, mut depth_rows) = (Vec::new(), Vec::new());
+    fb.read_color_rows(|_, row| color_rows.extend_from_slice(row));
+    fb.read_depth_rows(|_, row| depth_rows.extend_from_slice(row));
+    assert_eq!(color_rows, color);
+    assert_eq!(depth_rows, depth);
+    assert_eq!(fb.try_read_depth().expect("depth"), depth);
+    assert!(depth.iter().any(|&d| d < 1.0) && depth.contains(&1.0));
+}
+
+#[test]
+fn a_16384_squared_readback_streams_in_one_row_of_extra_memory() {
+    use kantele::rop::{framebuffer_bytes, readback_bytes};
+    let side = kantele::MAX_TARGET_SIZE;
+    assert_eq!(side, 16384);
+    // The target itself: 16 bytes of colour and 4 of depth per pixel.
+    let target = framebuffer_bytes(side, side);
+    assert_eq!(target, 16384 * 16384 * 20);
+    // Streaming an 8-bit PNG adds one row; a whole-frame 8-bit copy adds 1 GiB, a linear
+    // colour copy 4 GiB (what `Backend::read_frame` returns, for callers that need it).
+    assert_eq!(readback_bytes(side, 1, 4), 64 * 1024);
+    assert_eq!(readback_bytes(side, side, 4), 1 << 30);
+    assert_eq!(readback_bytes(side, side, 16), 1 << 32);
+    // Saturating, never wrapping, for sizes no target has.
+    assert_eq!(readback_bytes(u32::MAX, u32::MAX, usize::MAX), usize::MAX);
+}

@@ -153,8 +153,8 @@ impl Backend for CpuBackend {
         Ok(FrameImage {
             width: fb.width(),
             height: fb.height(),
-            color: fb.read_color(),
-            depth: fb.read_depth(),
+            color: fb.try_read_color()?,
+            depth: fb.try_read_depth()?,
         })
     }
 }
