@@ -187,6 +187,16 @@ fn a_1e6_ground_plane_through_the_near_plane_covers_exactly_the_screen_below_the
         Vec3::new(4.0, 0.0, 7.0),
         e,
     );
+    // Eye far from the origin, and high above it. (Not: an eye so close to the ground that the
+    // near plane cuts it on screen. Its f32 clip coordinates (z ≈ 1e6, ulp 0.06) place the
+    // near plane only to within ±15 % of 0.1, so the exact world-space answer is not what
+    // any f32 pipeline, OpenGL included, can draw.)
+    for (eye, target) in [
+        (Vec3::new(3e5, 2.0, 1e5), Vec3::new(3e5, 0.0, 1e5 - 4.0)),
+        (Vec3::new(0.0, 30.0, 0.0), Vec3::new(1.0, 0.0, 0.0)),
+    ] {
+        check_ground_plane((400, 300), eye, target, e);
+    }
 }
 
 /// A triangle whose edge from `(−r, −m·r)` to `(r, m·r)` (clip space, w = 1) crosses the
