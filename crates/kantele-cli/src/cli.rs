@@ -79,6 +79,12 @@ pub enum BackendKind {
     Cpu,
     /// The OpenGL reference backend (headless EGL).
     Gl,
+    /// The CUDA backend: the whole tiled pipeline on an NVIDIA GPU (cargo feature `cuda`).
+    Cuda,
+    /// The CUDA backend with the thesis' "one call, one triangle" scheme (a baseline).
+    CudaOcot,
+    /// The CUDA backend with the thesis' "one call, many triangles" scheme (a baseline).
+    CudaOcmt,
 }
 
 impl BackendKind {
@@ -87,6 +93,9 @@ impl BackendKind {
         match self {
             BackendKind::Cpu => "cpu",
             BackendKind::Gl => "gl",
+            BackendKind::Cuda => "cuda",
+            BackendKind::CudaOcot => "cuda-ocot",
+            BackendKind::CudaOcmt => "cuda-ocmt",
         }
     }
 }
@@ -345,7 +354,12 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 }
 
 fn parse_strategy(s: &str) -> Result<Strategy, String> {
-    s.parse()
+    match s {
+        "ocot" | "ocmt" => Err(format!(
+            "'{s}' is a CUDA scheme: use --backend cuda-{s} (--strategy picks the CPU traversal)"
+        )),
+        _ => s.parse(),
+    }
 }
 
 fn parse_threads(s: &str) -> Result<usize, String> {

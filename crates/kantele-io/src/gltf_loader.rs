@@ -30,6 +30,7 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_emissive_strength",
     "EXT_mesh_gpu_instancing",
     "EXT_texture_webp",
+    "EXT_meshopt_compression",
 ];
 
 /// Extensions that change how geometry or images are stored and that this loader cannot decode:
@@ -62,6 +63,10 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     };
     let (json, blob) = split_glb(&bytes).map_err(invalid)?;
     drop(bytes);
+    // A parsed JSON tree takes several times its text.
+    budget
+        .charge(json.len() as u64, 16, "parsing the glTF JSON")
+        .map_err(invalid)?;
     let mut value: serde_json::Value = serde_json::from_slice(&json)
         .map_err(|e| invalid(format!("not a valid glTF file: {e}")))?;
     drop(json);
@@ -77,7 +82,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     let document = check_extensions(path, root, &mut info)?;
     let policy = ReadPolicy::new(path, &options.allow_read);
     let buffers = load_buffers(path, &document, blob, &policy, &mut budget)?;
-    let decoded_views = HashMap::new();
+    let decoded_views = crate::meshopt_views::decode_views(&document, &buffers, &mut budget)
+        .map_err(|e| LoadError::invalid(path, e))?;
     Loader {
         path,
         document: &document,
@@ -1027,6 +1033,10 @@ impl Loader<'_> {
             material,
         };
         if converted.normals.is_none() {
+            // De-indexed: one vertex (position, normal, texcoord, colour) per corner.
+            self.budget
+                .charge(converted.indices.len() as u64, 48, &what)
+                .map_err(|e| self.invalid(e))?;
             flat_normals(&mut converted);
         }
         self.scene.meshes.push(converted);

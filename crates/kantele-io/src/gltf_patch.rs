@@ -61,32 +61,6 @@ pub(crate) fn patch(root: &mut Value) -> Result<Patched, String> {
             }
         }
     }
-    // EXT_meshopt_compression: readable only through an uncompressed fallback that has data.
-    let buffers = object.get("buffers").and_then(Value::as_array);
-    if let Some(Value::Array(views)) = object.get("bufferViews") {
-        for (v, view) in views.iter().enumerate() {
-            if view
-                .pointer("/extensions/EXT_meshopt_compression")
-                .is_none()
-            {
-                continue;
-            }
-            let fallback_has_data = view
-                .get("buffer")
-                .and_then(Value::as_u64)
-                .and_then(|b| buffers?.get(usize::try_from(b).ok()?))
-                .is_some_and(|b| {
-                    b.get("uri").is_some()
-                        || b.pointer("/extensions/EXT_meshopt_compression/fallback")
-                            != Some(&Value::Bool(true))
-                });
-            if !fallback_has_data {
-                return Err(format!(
-                    "buffer view {v} uses EXT_meshopt_compression (meshoptimizer-compressed data) without an uncompressed fallback, which this loader cannot decode"
-                ));
-            }
-        }
-    }
     let image_count = object
         .get("images")
         .and_then(Value::as_array)

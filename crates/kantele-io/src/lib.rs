@@ -44,6 +44,7 @@ mod ear_clip;
 mod gltf_loader;
 mod gltf_patch;
 pub mod mesh_util;
+mod meshopt_views;
 mod obj_loader;
 mod obj_text;
 pub mod output;

@@ -253,6 +253,10 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
             material,
         };
         if mesh.normals.is_none() {
+            // De-indexed: one vertex (position, normal, texcoord, colour) per corner.
+            budget
+                .charge(mesh.indices.len() as u64, 48, &what)
+                .map_err(|e| LoadError::invalid(path, e))?;
             flat_normals(&mut mesh);
         }
         scene.meshes.push(mesh);

@@ -25,18 +25,18 @@ fn image_format(mime_type: Option<&str>) -> Option<image::ImageFormat> {
     }
 }
 
+/// A reader for the image: the format is recognised from the data (files often declare the
+/// wrong MIME type), falling back to `mime_type` when the data is not recognised.
 fn reader<'a>(
     bytes: &'a [u8],
     mime_type: Option<&str>,
 ) -> Result<image::ImageReader<std::io::Cursor<&'a [u8]>>, ImageError> {
-    let cursor = std::io::Cursor::new(bytes);
-    let mut reader = image::ImageReader::new(cursor);
-    match image_format(mime_type) {
-        Some(format) => reader.set_format(format),
-        None => {
-            reader = reader
-                .with_guessed_format()
-                .map_err(|e| ImageError::Decode(format!("cannot decode image: {e}")))?
+    let mut reader = image::ImageReader::new(std::io::Cursor::new(bytes))
+        .with_guessed_format()
+        .map_err(|e| ImageError::Decode(format!("cannot decode image: {e}")))?;
+    if reader.format().is_none() {
+        if let Some(format) = image_format(mime_type) {
+            reader.set_format(format);
         }
     }
     Ok(reader)
@@ -50,8 +50,8 @@ pub(crate) fn image_size(bytes: &[u8], mime_type: Option<&str>) -> Result<(u32, 
 }
 
 /// Decodes an encoded PNG, JPEG or WebP image into an sRGB texture with its mip chain, after
-/// reading its size from the header and charging the texture's memory to `budget`. `mime_type`
-/// picks the decoder when given; otherwise the format is guessed from the data.
+/// reading its size from the header and charging the texture's memory to `budget`. The format
+/// is recognised from the data, `mime_type` is the fallback.
 pub(crate) fn decode_srgb_within(
     bytes: &[u8],
     mime_type: Option<&str>,

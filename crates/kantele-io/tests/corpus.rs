@@ -4,7 +4,7 @@
 //!
 //! The real files are read from the shared folder (never copied into the repository). When it
 //! is absent the test says so and skips them, unless `KANTELE_REQUIRE` contains `scenes`,
-//! where it fails.
+//! where it fails. The shared folder is `../shared` beside the checkout, or `KANTELE_SHARED`.
 
 mod common;
 
@@ -356,7 +356,11 @@ fn concave_obj_face_keeps_its_notch() {
 /// The shared real-world folder, or `None` (with a printed reason) when it is absent; absent
 /// and required (`KANTELE_REQUIRE` contains `scenes`) fails.
 fn realworld() -> Option<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared/realworld");
+    // `KANTELE_SHARED` names the shared folder when it is not beside the checkout.
+    let shared = std::env::var_os("KANTELE_SHARED")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
+    let dir = shared.join("realworld");
     if dir.is_dir() {
         return Some(dir);
     }
@@ -436,7 +440,7 @@ fn realworld_files_render_with_their_properties() {
     let sample = uv_box("BaseColorSample");
     for cell in ["BaseColorUV0", "BaseColorUV1"] {
         let (lo, hi) = uv_box(cell);
-        let eps = 1e-3;
+        let eps = 0.02; // the cells' margins differ slightly; a wrong rotation is ~0.3 away
         assert!(
             lo.cmpge(sample.0 - eps).all() && hi.cmple(sample.1 + eps).all(),
             "{cell}: uv box {lo}..{hi} outside the sample's {}..{}",

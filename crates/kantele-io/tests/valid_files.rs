@@ -165,3 +165,107 @@ fn quantized_attributes_of_every_allowed_type() {
         loaded.info.warnings
     );
 }
+
+#[test]
+fn webp_textures_decode() {
+    // A 2 × 2 lossless WebP (red, green / blue, white), shown through EXT_texture_webp with a
+    // PNG fallback of another colour: the WebP must win.
+    let rgba = [
+        255u8, 0, 0, 255, 0, 255, 0, 255, 0, 0, 255, 255, 255, 255, 255, 255,
+    ];
+    let image = image::RgbaImage::from_raw(2, 2, rgba.to_vec()).unwrap();
+    let mut webp = std::io::Cursor::new(Vec::new());
+    image.write_to(&mut webp, image::ImageFormat::WebP).unwrap();
+    let mut g = textured_quad();
+    g.images[0] = png(1, 1, &[0, 0, 0, 255]);
+    let webp_image = g.image(webp.into_inner());
+    g.json["images"][webp_image]["mimeType"] = json!("image/webp");
+    g.json["textures"][0]["extensions"] = json!({"EXT_texture_webp": {"source": webp_image}});
+    g.json["extensionsUsed"] = json!(["EXT_texture_webp", "KHR_lights_punctual"]);
+    let loaded = load_scene(&write(&g, "webp")).expect("webp texture");
+    let texture = &loaded.scene.textures[0];
+    assert_eq!((texture.width(), texture.height()), (2, 2));
+    assert_eq!(texture.levels()[0].texels[1], Vec4::new(0.0, 1.0, 0.0, 1.0));
+}
+
+#[test]
+fn meshopt_compressed_views_decode() {
+    let positions: [[f32; 3]; 4] = [
+        [-1.0, -1.0, 0.0],
+        [1.0, -1.0, 0.0],
+        [1.0, 1.0, 0.0],
+        [-1.0, 1.0, 0.0],
+    ];
+    let indices: [u32; 6] = [0, 1, 2, 0, 2, 3];
+    // Normals through the octahedral filter (8-bit), as gltfpack writes them.
+    let normals: Vec<[i8; 4]> = meshopt::encode_filter_oct(&[[0.0, 0.0, 1.0, 0.0]; 4], 8);
+    let encoded_positions = meshopt::encode_vertex_buffer(&positions).unwrap();
+    let encoded_normals = meshopt::encode_vertex_buffer(&normals).unwrap();
+    let encoded_indices = meshopt::encode_index_buffer(&indices, 4).unwrap();
+
+    let mut g = Gltf::new();
+    let compressed = |g: &mut Gltf,
+                      bytes: &[u8],
+                      stride: usize,
+                      count: usize,
+                      mode: &str,
+                      filter: &str| {
+        let source = g.view(bytes);
+        let source_offset = g.json["bufferViews"][source]["byteOffset"].clone();
+        // The view itself points into the (empty) fallback buffer 1.
+        let mut view = json!({"buffer": 1, "byteOffset": 0, "byteLength": stride * count, "byteStride": stride,
+            "extensions": {"EXT_meshopt_compression": {"buffer": 0, "byteOffset": source_offset,
+                "byteLength": bytes.len(), "byteStride": stride, "count": count, "mode": mode, "filter": filter}}});
+        if mode != "ATTRIBUTES" {
+            view.as_object_mut().unwrap().remove("byteStride");
+        }
+        g.json["bufferViews"][source] = view;
+        source
+    };
+    let pv = compressed(&mut g, &encoded_positions, 12, 4, "ATTRIBUTES", "NONE");
+    let nv = compressed(&mut g, &encoded_normals, 4, 4, "ATTRIBUTES", "OCTAHEDRAL");
+    let iv = compressed(&mut g, &encoded_indices, 4, 6, "TRIANGLES", "NONE");
+    let accessors = g.json["accessors"].as_array_mut().unwrap();
+    accessors.push(json!({"bufferView": pv, "componentType": 5126, "type": "VEC3", "count": 4, "min": [-1, -1, 0], "max": [1, 1, 0]}));
+    accessors.push(json!({"bufferView": nv, "componentType": 5120, "normalized": true, "type": "VEC3", "count": 4}));
+    accessors.push(json!({"bufferView": iv, "componentType": 5125, "type": "SCALAR", "count": 6}));
+    let n = accessors.len();
+    let mesh = g.mesh(
+        "m",
+        vec![json!({"attributes": {"POSITION": n - 3, "NORMAL": n - 2}, "indices": n - 1})],
+    );
+    let node = g.node(json!({"mesh": mesh}));
+    g.root(node);
+    g.json["extensionsUsed"] = json!(["EXT_meshopt_compression", "KHR_mesh_quantization"]);
+    g.json["extensionsRequired"] = json!(["EXT_meshopt_compression", "KHR_mesh_quantization"]);
+    let path = temp_dir("meshopt").join("meshopt.glb");
+    g.write_glb(&path);
+    // Add the fallback buffer (no data) after writing: patch the GLB's JSON.
+    let bytes = std::fs::read(&path).unwrap();
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let mut doc: serde_json::Value = serde_json::from_slice(&bytes[20..20 + json_len]).unwrap();
+    doc["buffers"].as_array_mut().unwrap().push(
+        json!({"byteLength": 1024, "extensions": {"EXT_meshopt_compression": {"fallback": true}}}),
+    );
+    let mut text = serde_json::to_vec(&doc).unwrap();
+    while text.len() % 4 != 0 {
+        text.push(b' ');
+    }
+    let bin = &bytes[20 + json_len..];
+    let mut out = b"glTF".to_vec();
+    out.extend(2u32.to_le_bytes());
+    out.extend(((12 + 8 + text.len() + bin.len()) as u32).to_le_bytes());
+    out.extend((text.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(&text);
+    out.extend(bin);
+    std::fs::write(&path, out).unwrap();
+
+    let loaded = load_scene(&path).expect("meshopt file");
+    let m = &loaded.scene.meshes[0];
+    assert_eq!(m.positions, positions.map(Vec3::from).to_vec());
+    assert_eq!(m.indices, indices.to_vec());
+    for n in m.normals.as_ref().unwrap() {
+        assert!((*n - Vec3::Z).length() < 0.01, "{n}");
+    }
+}

@@ -50,7 +50,7 @@ impl RasterCounters {
 pub(super) fn raster_tiles(
     framebuffer: &mut Framebuffer,
     bins: &TileBins,
-    geometry: &GeometryOutput,
+    geometry: &GeometryOutput<'_>,
     draws: &[Box<dyn DrawJob + '_>],
     strategy: Strategy,
     isa: Isa,
@@ -70,7 +70,7 @@ pub(super) fn raster_tiles(
                 if k % TRIANGLES_PER_CHECK == 0 && budget.exhausted() {
                     break;
                 }
-                let tri = &geometry.triangles[t as usize];
+                let tri = geometry.triangle(t);
                 let draw = &draws[tri.draw as usize];
                 // Early rejection: behind everything already in this tile.
                 if draw.rejects_by_depth_bound() {
@@ -85,7 +85,7 @@ pub(super) fn raster_tiles(
                 if coverage.is_empty() {
                     continue;
                 }
-                let attrs = geometry.attrs_of(t as usize, draws);
+                let attrs = geometry.attrs(t);
                 let c = draw.raster(tri, attrs, &coverage, tile, isa);
                 counters = RasterCounters::sum(counters, c);
             }

@@ -37,7 +37,7 @@ use crate::error::RenderError;
 use crate::raster::bin::TileBins;
 use crate::raster::Strategy;
 use crate::rop::Framebuffer;
-use crate::setup::Viewport;
+use crate::setup::{TriangleSetup, Viewport};
 use crate::simd::Isa;
 use crate::stats::{FrameStats, FrameStop};
 use crate::{MAX_TARGET_SIZE, MAX_VARYINGS};
@@ -164,6 +164,7 @@ impl Renderer {
             clear_color,
             clear_depth,
             draws: Vec::new(),
+            batches: 0,
         }
     }
 }
@@ -191,6 +192,8 @@ pub struct Frame<'r, 'a> {
     clear_color: Option<Vec4>,
     clear_depth: Option<f32>,
     draws: Vec<Box<dyn DrawJob + 'a>>,
+    /// Primitive-stage batches the queued draws will make (bounded by `TriangleRef`).
+    batches: usize,
 }
 
 impl<'a> Frame<'_, 'a> {
@@ -224,6 +227,11 @@ impl<'a> Frame<'_, 'a> {
                 vertex_count: vertices.len(),
             });
         }
+        let batches = self.batches + (count / 3).div_ceil(geometry::PRIMITIVE_CHUNK);
+        if batches > crate::raster::bin::TriangleRef::MAX_BATCHES {
+            return Err(RenderError::FrameTooLarge);
+        }
+        self.batches = batches;
         self.draws.push(Box::new(DrawCall {
             shader,
             vertices,
@@ -242,6 +250,7 @@ impl<'a> Frame<'_, 'a> {
             clear_color,
             clear_depth,
             draws,
+            batches: _,
         } = self;
         let start = Instant::now();
         let mut stats = FrameStats {
@@ -265,7 +274,7 @@ impl<'a> Frame<'_, 'a> {
             let viewport = Viewport::new(framebuffer.width(), framebuffer.height());
             let geometry_start = Instant::now();
             run_geometry(&draws, &viewport, &mut stats, scratch, &budget);
-            let geometry = &scratch.output;
+            let geometry = scratch.output();
             stats.geometry_time = geometry_start.elapsed();
             if budget.exhausted() {
                 return;
@@ -273,16 +282,24 @@ impl<'a> Frame<'_, 'a> {
 
             let binning_start = Instant::now();
             let grid = *framebuffer.grid();
-            stats.bin_entries = bins.bin_triangles(&grid, &geometry.triangles);
-            stats.triangles_binned = geometry.triangles.len() as u64;
+            let batches: Vec<&[TriangleSetup]> = geometry.triangle_batches().collect();
+            stats.bin_entries = bins.bin_batches(&grid, &batches);
+            stats.triangles_binned = batches.iter().map(|b| b.len() as u64).sum();
             stats.binning_time = binning_start.elapsed();
             if budget.exhausted() {
                 return;
             }
 
             let raster_start = Instant::now();
-            let counters =
-                fragment::raster_tiles(framebuffer, bins, geometry, &draws, strategy, isa, &budget);
+            let counters = fragment::raster_tiles(
+                framebuffer,
+                bins,
+                &geometry,
+                &draws,
+                strategy,
+                isa,
+                &budget,
+            );
             stats.fragments_covered = counters.covered;
             stats.tiles_depth_rejected = counters.tile_rejected;
             stats.blocks_depth_rejected = counters.blocks_rejected;
