@@ -48,6 +48,11 @@ pub const NEAR_PLANE: ClipPlane = Vec4::new(0.0, 0.0, 1.0, 1.0);
 /// 2.2e37), and so does the sum of three such values in perspective-correct interpolation.
 pub const W_MIN: f32 = 4.0 * f32::MIN_POSITIVE;
 
+/// The smallest `w` of a vertex accepted without clipping: the old name of [`W_MIN`], kept for
+/// mirrors of these rules (the CUDA kernels' `KANTELE_W_EPSILON`). The clip plane itself is
+/// relative now (see the module docs).
+pub const W_EPSILON: f32 = W_MIN;
+
 /// The `w` plane of a polygon lies at `W_RELATIVE_EPSILON · w_max` (or [`W_MIN`] if larger),
 /// `w_max` being the polygon's largest `w`: scale-free, and 2^-40 below anything a near plane
 /// at a sane near/far ratio cuts.
