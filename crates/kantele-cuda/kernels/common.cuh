@@ -290,27 +290,36 @@ struct ClipVertex {
     float varyings[NV];
 };
 
+// Positions are kept in double while clipping (as the core's `ClipPolygon`), rounded to float
+// once at the end.
+struct D4 {
+    double x, y, z, w;
+};
+
 struct ClipPolygon {
     ClipVertex v[KANTELE_MAX_CLIPPED_VERTICES];
+    D4 p[KANTELE_MAX_CLIPPED_VERTICES];
     int len;
 };
 
-// The signed distance to plane `plane` (0 near, 1 w ≥ ε, 2..5 guard band), as the CPU computes
-// it: near `z + w`, `w − ε`, guard planes as a glam `Vec4::dot`.
-__device__ __forceinline__ float clip_distance(int plane, V4 v, float kx, float ky) {
-    switch (plane) {
-        case 0: return add(v.z, v.w);
-        case 1: return sub(v.w, KANTELE_W_EPSILON);
-        case 2: return v4_dot({-1.0f, 0.0f, 0.0f, kx}, v);
-        case 3: return v4_dot({1.0f, 0.0f, 0.0f, kx}, v);
-        case 4: return v4_dot({0.0f, -1.0f, 0.0f, ky}, v);
-        default: return v4_dot({0.0f, 1.0f, 0.0f, ky}, v);
-    }
+__device__ __forceinline__ double dmul(double a, double b) { return __dmul_rn(a, b); }
+__device__ __forceinline__ double dadd(double a, double b) { return __dadd_rn(a, b); }
+__device__ __forceinline__ double dsub(double a, double b) { return __dsub_rn(a, b); }
+__device__ __forceinline__ double ddiv(double a, double b) { return __ddiv_rn(a, b); }
+
+// The polygon's `w` plane lies at 2^-40 · (largest w), or KANTELE_W_EPSILON (`W_MIN`) if larger.
+#define KANTELE_W_RELATIVE_EPSILON (1.0 / 1099511627776.0)
+
+// `dot(plane, p) − offset` in double, as glam's `DVec4::dot` (x, y, z, w in order).
+__device__ __forceinline__ double clip_distance(D4 plane, double offset, D4 p) {
+    double d = dadd(dadd(dadd(dmul(plane.x, p.x), dmul(plane.y, p.y)), dmul(plane.z, p.z)),
+                    dmul(plane.w, p.w));
+    return dsub(d, offset);
 }
 
-// `ClipPolygon::clip_plane`: Sutherland–Hodgman against one plane, interpolating from the inside
-// vertex towards the outside one.
-__device__ void clip_plane(ClipPolygon& poly, int plane, float kx, float ky) {
+// `ClipPolygon::clip_plane`: Sutherland–Hodgman against one plane, in double, interpolating
+// from the inside vertex towards the outside one.
+__device__ void clip_plane(ClipPolygon& poly, D4 plane, double offset) {
     if (poly.len < 3) {
         poly.len = 0;
         return;
@@ -318,35 +327,45 @@ __device__ void clip_plane(ClipPolygon& poly, int plane, float kx, float ky) {
     const int count = poly.len;
     bool all_inside = true;
     for (int i = 0; i < count; ++i) {
-        if (!(clip_distance(plane, poly.v[i].pos, kx, ky) >= 0.0f)) all_inside = false;
+        if (!(clip_distance(plane, offset, poly.p[i]) >= 0.0)) all_inside = false;
     }
     if (all_inside) return;
     ClipVertex src[KANTELE_MAX_CLIPPED_VERTICES];
-    for (int i = 0; i < count; ++i) src[i] = poly.v[i];
+    D4 src_p[KANTELE_MAX_CLIPPED_VERTICES];
+    for (int i = 0; i < count; ++i) {
+        src[i] = poly.v[i];
+        src_p[i] = poly.p[i];
+    }
     int out = 0;
     for (int i = 0; i < count; ++i) {
-        const ClipVertex& a = src[i];
-        const ClipVertex& b = src[(i + 1) % count];
-        float da = clip_distance(plane, a.pos, kx, ky);
-        float db = clip_distance(plane, b.pos, kx, ky);
-        if (da >= 0.0f) {
-            poly.v[out] = a;
+        const int j = (i + 1) % count;
+        double da = clip_distance(plane, offset, src_p[i]);
+        double db = clip_distance(plane, offset, src_p[j]);
+        if (da >= 0.0) {
+            poly.v[out] = src[i];
+            poly.p[out] = src_p[i];
             out += 1;
         }
-        if ((da >= 0.0f) != (db >= 0.0f)) {
-            const ClipVertex& inner = da >= 0.0f ? a : b;
-            const ClipVertex& outer = da >= 0.0f ? b : a;
-            float d_in = da >= 0.0f ? da : db;
-            float d_out = da >= 0.0f ? db : da;
-            float t = divide(d_in, sub(d_in, d_out));
-            ClipVertex v;
-            v.pos = v4_add(inner.pos, v4_mul_s(v4_sub(outer.pos, inner.pos), t));
+        if ((da >= 0.0) != (db >= 0.0)) {
+            const int inner = da >= 0.0 ? i : j;
+            const int outer = da >= 0.0 ? j : i;
+            double d_in = da >= 0.0 ? da : db;
+            double d_out = da >= 0.0 ? db : da;
+            double t = ddiv(d_in, dsub(d_in, d_out));
+            ClipVertex v = src[inner];
             for (int k = 0; k < NV; ++k) {
-                v.varyings[k] =
-                    add(inner.varyings[k], mul(sub(outer.varyings[k], inner.varyings[k]), t));
+                double a = (double)src[inner].varyings[k];
+                double b = (double)src[outer].varyings[k];
+                v.varyings[k] = (float)dadd(a, dmul(dsub(b, a), t));
             }
+            const D4 pi = src_p[inner];
+            const D4 po = src_p[outer];
             if (out < KANTELE_MAX_CLIPPED_VERTICES) {
                 poly.v[out] = v;
+                poly.p[out] = {dadd(pi.x, dmul(dsub(po.x, pi.x), t)),
+                               dadd(pi.y, dmul(dsub(po.y, pi.y), t)),
+                               dadd(pi.z, dmul(dsub(po.z, pi.z), t)),
+                               dadd(pi.w, dmul(dsub(po.w, pi.w), t))};
                 out += 1;
             }
         }
@@ -354,9 +373,38 @@ __device__ void clip_plane(ClipPolygon& poly, int plane, float kx, float ky) {
     poly.len = out;
 }
 
-// `ClipPolygon::clip`: near, w ≥ ε, then the four guard-band planes.
+// `ClipPolygon::clip`: near, the relative w plane, then the four guard-band planes; positions
+// rounded to float once; a vertex left with w < W_MIN or a non-finite coordinate drops the
+// polygon. `poly.p` must hold the vertices' positions in double on entry.
 __device__ void clip_polygon(ClipPolygon& poly, float kx, float ky) {
-    for (int plane = 0; plane < 6; ++plane) clip_plane(poly, plane, kx, ky);
+    for (int i = 0; i < poly.len; ++i) {
+        const V4 q = poly.v[i].pos;
+        poly.p[i] = {(double)q.x, (double)q.y, (double)q.z, (double)q.w};
+    }
+    clip_plane(poly, {0.0, 0.0, 1.0, 1.0}, 0.0);
+    double w_max = 0.0;
+    for (int i = 0; i < poly.len; ++i) w_max = fmax(w_max, poly.p[i].w);
+    double w_floor = fmax(dmul(KANTELE_W_RELATIVE_EPSILON, w_max), (double)KANTELE_W_EPSILON);
+    clip_plane(poly, {0.0, 0.0, 0.0, 1.0}, w_floor);
+    const double dkx = (double)kx, dky = (double)ky;
+    clip_plane(poly, {-1.0, 0.0, 0.0, dkx}, 0.0);
+    clip_plane(poly, {1.0, 0.0, 0.0, dkx}, 0.0);
+    clip_plane(poly, {0.0, -1.0, 0.0, dky}, 0.0);
+    clip_plane(poly, {0.0, 1.0, 0.0, dky}, 0.0);
+    if (poly.len < 3) {
+        poly.len = 0;
+        return;
+    }
+    for (int i = 0; i < poly.len; ++i) {
+        const D4 q = poly.p[i];
+        V4 f = {(float)q.x, (float)q.y, (float)q.z, (float)q.w};
+        poly.v[i].pos = f;
+        if (!(isfinite(f.x) && isfinite(f.y) && isfinite(f.z) && isfinite(f.w)) ||
+            f.w < KANTELE_W_EPSILON) {
+            poly.len = 0;
+            return;
+        }
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

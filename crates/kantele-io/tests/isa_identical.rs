@@ -23,6 +23,7 @@ fn render(
         threads: Some(threads),
         strategy,
         isa: Some(isa),
+        ..CpuOptions::default()
     })
     .expect("cpu backend");
     cpu.load(scene.clone()).expect("load");

@@ -76,6 +76,7 @@ fn bench_fill(c: &mut Criterion) {
                     threads: Some(1),
                     strategy,
                     isa: Some(isa),
+                    ..RendererOptions::default()
                 };
                 let mut renderer = Renderer::new(SIZE, SIZE, options).expect("renderer");
                 let state = RenderState {

@@ -76,4 +76,14 @@ pub enum RenderError {
         /// What went wrong.
         message: String,
     },
+    /// The frame was cancelled by the caller's flag before it finished (the picture is partly
+    /// drawn).
+    #[error("frame cancelled")]
+    Cancelled,
+    /// The frame ran out of its time budget before it finished (the picture is partly drawn).
+    #[error("frame stopped after its time budget of {} ms", budget.as_millis())]
+    TimedOut {
+        /// The budget it had.
+        budget: std::time::Duration,
+    },
 }

@@ -203,6 +203,23 @@ fn filled_vec<T: Clone>(n: usize, value: T) -> Result<Vec<T>, RenderError> {
     Ok(v)
 }
 
+/// Bytes the tiles of a `width × height` target take: 16 bytes of linear RGBA and 4 of depth
+/// per pixel, for every pixel of the whole 64 × 64 tiles covering it (saturating).
+pub fn framebuffer_bytes(width: u32, height: u32) -> usize {
+    let grid = TileGrid::new(width, height);
+    grid.tile_count()
+        .saturating_mul(TILE_PIXELS)
+        .saturating_mul(5 * std::mem::size_of::<f32>())
+}
+
+/// Bytes a whole-frame readback of a `width × height` target takes at `bytes_per_pixel`
+/// (saturating); the row-streaming readers need only `width × bytes_per_pixel`.
+pub fn readback_bytes(width: u32, height: u32, bytes_per_pixel: usize) -> usize {
+    (width as usize)
+        .saturating_mul(height as usize)
+        .saturating_mul(bytes_per_pixel)
+}
+
 /// A colour + depth target stored as tiles.
 #[derive(Clone, Debug)]
 pub struct Framebuffer {
@@ -255,37 +272,119 @@ impl Framebuffer {
             .for_each(|tile| tile.fill(color, depth));
     }
 
-    fn read<T: Copy>(&self, mut get: impl FnMut(&TileBuffer, usize) -> T) -> Vec<T> {
-        let (w, h) = (self.grid.width as usize, self.grid.height as usize);
-        let mut out = Vec::with_capacity(w * h);
-        for y in 0..h {
-            for x in 0..w {
-                let tile = (y >> TILE_LOG2) * self.grid.tiles_x as usize + (x >> TILE_LOG2);
-                out.push(get(
-                    &self.tiles[tile],
-                    TileBuffer::index(x as i32, y as i32),
-                ));
+    // Readback (robust branch). Everything goes through `read_rows`, which holds one row of
+    // output at a time: the streaming readers add one row to the framebuffer's memory, the
+    // whole-frame readers exactly their result (reserved fallibly in the `try_` forms).
+
+    /// Calls `emit(y, row)` for every row, top to bottom, with `row` holding `per_pixel`
+    /// values per pixel made by `get(tile, index, out)`; one row buffer is reused.
+    fn read_rows<T: Copy + Default>(
+        &self,
+        per_pixel: usize,
+        get: impl Fn(&TileBuffer, usize, &mut [T]),
+        mut emit: impl FnMut(u32, &[T]),
+    ) {
+        let w = self.grid.width as usize;
+        let mut row = vec![T::default(); w * per_pixel];
+        for y in 0..self.grid.height {
+            let tile_row = (y as usize >> TILE_LOG2) * self.grid.tiles_x as usize;
+            for (x, out) in row.chunks_exact_mut(per_pixel).enumerate() {
+                let tile = &self.tiles[tile_row + (x >> TILE_LOG2)];
+                get(tile, TileBuffer::index(x as i32, y as i32), out);
             }
+            emit(y, &row);
         }
-        out
     }
 
-    /// Linear RGBA, row-major, row 0 = top.
+    /// Streams linear RGBA a row at a time: `emit(y, row)` with `row` holding `width` pixels,
+    /// row 0 = top. Needs one row of memory (16 bytes per pixel of width).
+    pub fn read_color_rows(&self, mut emit: impl FnMut(u32, &[[f32; 4]])) {
+        self.read_rows(
+            1,
+            |t, i, out| out[0] = t.color_at(i).to_array(),
+            |y, row| emit(y, row),
+        );
+    }
+
+    /// Streams 8-bit RGBA (RGB sRGB-encoded when `srgb` is set) a row at a time: `emit(y, row)`
+    /// with `row` holding `4 × width` bytes, row 0 = top — what a PNG encoder consumes row by
+    /// row. Needs one row of memory.
+    pub fn read_rgba8_rows(&self, srgb: bool, emit: impl FnMut(u32, &[u8])) {
+        self.read_rows(
+            4,
+            |t, i, out| {
+                out.copy_from_slice(&crate::color::encode_rgba8(t.color_at(i).to_array(), srgb))
+            },
+            emit,
+        );
+    }
+
+    /// Streams window depth a row at a time: `emit(y, row)` with `row` holding `width` values,
+    /// row 0 = top. Needs one row of memory.
+    pub fn read_depth_rows(&self, emit: impl FnMut(u32, &[f32])) {
+        self.read_rows(1, |t, i, out| out[0] = t.depth[i], emit);
+    }
+
+    /// Bytes a whole-frame readback of `bytes_per_pixel` per pixel takes for this target.
+    pub fn readback_bytes(&self, bytes_per_pixel: usize) -> usize {
+        readback_bytes(self.grid.width, self.grid.height, bytes_per_pixel)
+    }
+
+    /// Collects rows into one vector of exactly `width × height × per_pixel` values, reserved
+    /// fallibly.
+    fn try_collect<T: Copy + Default>(
+        &self,
+        per_pixel: usize,
+        what: &'static str,
+        stream: impl FnOnce(&mut dyn FnMut(u32, &[T])),
+    ) -> Result<Vec<T>, RenderError> {
+        let len = self.grid.width as usize * self.grid.height as usize * per_pixel;
+        let mut out = Vec::new();
+        out.try_reserve_exact(len)
+            .map_err(|_| RenderError::OutOfMemory {
+                what,
+                bytes: len.saturating_mul(std::mem::size_of::<T>()),
+            })?;
+        stream(&mut |_, row| out.extend_from_slice(row));
+        Ok(out)
+    }
+
+    /// Linear RGBA, row-major, row 0 = top; an error instead of an abort when the memory for
+    /// the result (16 bytes per pixel) cannot be reserved.
+    pub fn try_read_color(&self) -> Result<Vec<[f32; 4]>, RenderError> {
+        self.try_collect(1, "colour readback", |emit| self.read_color_rows(emit))
+    }
+
+    /// 8-bit RGBA, row-major, row 0 = top; RGB sRGB-encoded when `srgb` is set; an error
+    /// instead of an abort when the memory for the result (4 bytes per pixel) cannot be
+    /// reserved.
+    pub fn try_read_rgba8(&self, srgb: bool) -> Result<Vec<u8>, RenderError> {
+        self.try_collect(4, "8-bit readback", |emit| self.read_rgba8_rows(srgb, emit))
+    }
+
+    /// Window depth, row-major, row 0 = top; an error instead of an abort when the memory for
+    /// the result (4 bytes per pixel) cannot be reserved.
+    pub fn try_read_depth(&self) -> Result<Vec<f32>, RenderError> {
+        self.try_collect(1, "depth readback", |emit| self.read_depth_rows(emit))
+    }
+
+    /// Linear RGBA, row-major, row 0 = top (one allocation of exactly the result; see
+    /// [`Framebuffer::try_read_color`] and [`Framebuffer::read_color_rows`]).
     pub fn read_color(&self) -> Vec<[f32; 4]> {
-        self.read(|t, i| t.color_at(i).to_array())
+        self.try_read_color().unwrap_or_else(|e| panic!("{e}"))
     }
 
-    /// 8-bit RGBA, row-major, row 0 = top; RGB sRGB-encoded when `srgb` is set.
+    /// 8-bit RGBA, row-major, row 0 = top; RGB sRGB-encoded when `srgb` is set (one allocation
+    /// of exactly the result; see [`Framebuffer::try_read_rgba8`] and
+    /// [`Framebuffer::read_rgba8_rows`]).
     pub fn read_rgba8(&self, srgb: bool) -> Vec<u8> {
-        self.read(|t, i| crate::color::encode_rgba8(t.color_at(i).to_array(), srgb))
-            .into_iter()
-            .flatten()
-            .collect()
+        self.try_read_rgba8(srgb).unwrap_or_else(|e| panic!("{e}"))
     }
 
-    /// Window depth, row-major, row 0 = top.
+    /// Window depth, row-major, row 0 = top (one allocation of exactly the result; see
+    /// [`Framebuffer::try_read_depth`] and [`Framebuffer::read_depth_rows`]).
     pub fn read_depth(&self) -> Vec<f32> {
-        self.read(|t, i| t.depth[i])
+        self.try_read_depth().unwrap_or_else(|e| panic!("{e}"))
     }
 
     /// The tile and the index within it of pixel `(x, y)`, if it lies on the target.

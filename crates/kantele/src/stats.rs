@@ -35,6 +35,17 @@ pub struct FrameStats {
     pub fragments_shaded: u64,
     /// Fragments the shader discarded.
     pub fragments_discarded: u64,
+    /// Colour channels of written fragments that were NaN (from the fragment shader, or from
+    /// blending infinities) and were written as 0 instead.
+    pub nan_color_channels: u64,
+    /// The picture came out empty (no pixel covered) although triangles were submitted that
+    /// were neither invalid nor wholly outside the view volume: a warning worth printing
+    /// (everything culled, degenerate, clipped away or rejected by depth is legal, but rarely
+    /// meant). See [`FrameStats::empty_picture_warning`].
+    pub empty_picture: bool,
+    /// Why the frame stopped before drawing everything, if it did (its budget ran out or the
+    /// caller cancelled it; the picture is then partly drawn).
+    pub stopped: Option<FrameStop>,
     /// Time in vertex shading, primitive assembly, clipping, culling and setup.
     pub geometry_time: Duration,
     /// Time sorting triangles into tile bins.
@@ -43,4 +54,43 @@ pub struct FrameStats {
     pub raster_time: Duration,
     /// Whole frame, wall clock.
     pub total_time: Duration,
+}
+
+/// Why a frame stopped before drawing everything.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum FrameStop {
+    /// The caller raised the renderer's cancellation flag.
+    Cancelled,
+    /// The frame's time budget ran out.
+    TimedOut {
+        /// The budget it had.
+        budget: Duration,
+    },
+}
+
+impl FrameStats {
+    /// Whether the picture came out empty although the frame had geometry inside the view
+    /// volume; the one-line warning to print then (`None` when the picture is not empty, or
+    /// when it is empty for an obvious reason: no triangles, all invalid or outside).
+    pub fn empty_picture_warning(&self) -> Option<String> {
+        self.empty_picture.then(|| {
+            format!(
+                "the picture is empty although {} of {} triangles lie inside the view volume \
+                 ({} culled, {} degenerate or smaller than a pixel, {} hidden by depth)",
+                self.triangles_in - self.triangles_invalid - self.triangles_rejected,
+                self.triangles_in,
+                self.triangles_culled,
+                self.triangles_degenerate,
+                self.tiles_depth_rejected + self.blocks_depth_rejected,
+            )
+        })
+    }
+
+    /// Whether the counters describe a picture that is empty although triangles inside the
+    /// view volume were submitted (sets [`FrameStats::empty_picture`]).
+    pub(crate) fn is_unexpectedly_empty(&self) -> bool {
+        self.stopped.is_none()
+            && self.fragments_covered == 0
+            && self.triangles_in > self.triangles_invalid + self.triangles_rejected
+    }
 }

@@ -275,6 +275,7 @@ fn every_strategy_and_thread_count_renders_the_same_image() {
                 threads: Some(threads),
                 strategy,
                 isa: Some(isa),
+                ..RendererOptions::default()
             },
         )
         .expect("renderer");

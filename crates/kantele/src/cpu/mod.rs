@@ -52,6 +52,19 @@ impl CpuBackend {
         self.renderer.set_strategy(strategy);
     }
 
+    /// A flag that cancels the frame in flight while it is `true` (see
+    /// [`Renderer::set_cancel_flag`]): [`Backend::render`] then returns
+    /// [`RenderError::Cancelled`]. The time budget is [`CpuOptions::timeout`].
+    pub fn set_cancel_flag(&mut self, flag: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
+        self.renderer.set_cancel_flag(flag);
+    }
+
+    /// Changes the time budget of a frame (`None`: unlimited); a frame over it makes
+    /// [`Backend::render`] return [`RenderError::TimedOut`].
+    pub fn set_timeout(&mut self, timeout: Option<std::time::Duration>) {
+        self.renderer.set_timeout(timeout);
+    }
+
     /// The underlying renderer (framebuffer access).
     pub fn renderer(&self) -> &Renderer {
         &self.renderer
@@ -132,7 +145,7 @@ impl Backend for CpuBackend {
             };
             frame.draw(shader, &mesh.vertices, Indices::U32(&mesh.indices), state)?;
         }
-        Ok(frame.end())
+        frame.try_end()
     }
 
     fn read_frame(&mut self) -> Result<FrameImage, RenderError> {
@@ -140,8 +153,8 @@ impl Backend for CpuBackend {
         Ok(FrameImage {
             width: fb.width(),
             height: fb.height(),
-            color: fb.read_color(),
-            depth: fb.read_depth(),
+            color: fb.try_read_color()?,
+            depth: fb.try_read_depth()?,
         })
     }
 }

@@ -5,8 +5,27 @@
 //! projection matrices) and the guard band `|x|, |y| ≤ k·w`. The far plane and the sides inside
 //! the guard band are left to the rasterizer (scissoring to the target and discarding depth
 //! outside [0, 1]), which gives the same pictures with far fewer clipped triangles.
+//!
+//! # Precision at any scale
+//!
+//! - The `w` plane is relative: `w ≥ max(W_MIN, W_RELATIVE_EPSILON · w_max)`, where `w_max` is
+//!   the largest `w` of the polygon after near clipping. A model of size 1e-9 (whose `w` is
+//!   about 1e-9 everywhere) is therefore kept, as OpenGL keeps it, and the plane still cuts
+//!   triangles that reach behind the eye at a `w` far below anything a sane near plane
+//!   produces. [`W_MIN`] keeps `1/w` (and the sum of three of them) finite in `f32`.
+//! - Intersections are computed in `f64` from the exact `f32` inputs: plane distances, the
+//!   parameter `t` and the interpolated positions and varyings. A 1e6 ground plane cut at a
+//!   near plane of 0.1 loses 24 bits to cancellation; `f32` had none to spare (its near edge
+//!   moved by tens of pixels), `f64` keeps 29. Triangles reaching |x/w| ≈ 1e12 keep about 13
+//!   bits after the guard-band cut, i.e. a hundredth of a pixel on ordinary targets.
+//! - A clipped polygon is rounded back to `f32` only at the end; a vertex that would then have
+//!   `w ≤ 0` or a non-finite coordinate drops the whole polygon (it cannot happen with the
+//!   planes above, but the contract is *never* `w ≤ 0`).
+//!
+//! Triangles that need no clipping ([`ClipTest::Accept`]) never come here, so ordinary
+//! geometry is set up from its unmodified vertex positions.
 
-use glam::Vec4;
+use glam::{DVec4, Vec4};
 
 use crate::MAX_VARYINGS;
 
@@ -24,8 +43,20 @@ pub type ClipPlane = Vec4;
 
 /// The near plane `z + w ≥ 0`.
 pub const NEAR_PLANE: ClipPlane = Vec4::new(0.0, 0.0, 1.0, 1.0);
-/// `w ≥ W_EPSILON`, written as a plane through a shifted origin (handled specially).
-pub const W_EPSILON: f32 = 1e-6;
+
+/// Smallest `w` a vertex handed to setup may have: `1/w` stays finite in `f32` (below
+/// 2.2e37), and so does the sum of three such values in perspective-correct interpolation.
+pub const W_MIN: f32 = 4.0 * f32::MIN_POSITIVE;
+
+/// The smallest `w` of a vertex accepted without clipping: the old name of [`W_MIN`], kept for
+/// mirrors of these rules (the CUDA kernels' `KANTELE_W_EPSILON`). The clip plane itself is
+/// relative now (see the module docs).
+pub const W_EPSILON: f32 = W_MIN;
+
+/// The `w` plane of a polygon lies at `W_RELATIVE_EPSILON · w_max` (or [`W_MIN`] if larger),
+/// `w_max` being the polygon's largest `w`: scale-free, and 2^-40 below anything a near plane
+/// at a sane near/far ratio cuts.
+pub const W_RELATIVE_EPSILON: f64 = 1.0 / (1u64 << 40) as f64;
 
 /// Most vertices a triangle can have after clipping against all planes (3 + one per plane).
 pub const MAX_CLIPPED_VERTICES: usize = 3 + 6;
@@ -35,7 +66,7 @@ pub const MAX_CLIPPED_VERTICES: usize = 3 + 6;
 pub enum ClipTest {
     /// Wholly outside one frustum plane: draw nothing.
     Reject,
-    /// Needs no clipping: inside the near plane, positive w, and inside the guard band.
+    /// Needs no clipping: inside the near plane, `w ≥ W_MIN`, and inside the guard band.
     Accept,
     /// Crosses the near plane or the guard band: clip.
     Clip,
@@ -60,12 +91,13 @@ impl GuardBand {
         }
     }
 
-    fn planes(&self) -> [ClipPlane; 4] {
+    fn planes(&self) -> [DVec4; 4] {
+        let (k_x, k_y) = (self.k_x as f64, self.k_y as f64);
         [
-            Vec4::new(-1.0, 0.0, 0.0, self.k_x),
-            Vec4::new(1.0, 0.0, 0.0, self.k_x),
-            Vec4::new(0.0, -1.0, 0.0, self.k_y),
-            Vec4::new(0.0, 1.0, 0.0, self.k_y),
+            DVec4::new(-1.0, 0.0, 0.0, k_x),
+            DVec4::new(1.0, 0.0, 0.0, k_x),
+            DVec4::new(0.0, -1.0, 0.0, k_y),
+            DVec4::new(0.0, 1.0, 0.0, k_y),
         ]
     }
 }
@@ -84,10 +116,7 @@ pub fn classify(p: [Vec4; 3], guard: &GuardBand) -> ClipTest {
         return ClipTest::Reject;
     }
     let inside = |v: Vec4| {
-        v.z >= -v.w
-            && v.w >= W_EPSILON
-            && v.x.abs() <= guard.k_x * v.w
-            && v.y.abs() <= guard.k_y * v.w
+        v.z >= -v.w && v.w >= W_MIN && v.x.abs() <= guard.k_x * v.w && v.y.abs() <= guard.k_y * v.w
     };
     if p.iter().all(|&v| inside(v)) {
         ClipTest::Accept
@@ -96,10 +125,12 @@ pub fn classify(p: [Vec4; 3], guard: &GuardBand) -> ClipTest {
     }
 }
 
-/// A convex polygon of clip vertices, at most [`MAX_CLIPPED_VERTICES`].
+/// A convex polygon of clip vertices, at most [`MAX_CLIPPED_VERTICES`]. Positions are kept in
+/// `f64` while clipping and rounded to `f32` once, at the end.
 #[derive(Clone, Debug)]
 pub struct ClipPolygon {
     vertices: [ClipVertex; MAX_CLIPPED_VERTICES],
+    positions: [DVec4; MAX_CLIPPED_VERTICES],
     len: usize,
 }
 
@@ -109,7 +140,15 @@ impl ClipPolygon {
         let mut vertices = [a; MAX_CLIPPED_VERTICES];
         vertices[1] = b;
         vertices[2] = c;
-        Self { vertices, len: 3 }
+        let mut positions = [DVec4::ZERO; MAX_CLIPPED_VERTICES];
+        for (p, v) in positions.iter_mut().zip(&vertices[..3]) {
+            *p = v.pos_clip.as_dvec4();
+        }
+        Self {
+            vertices,
+            positions,
+            len: 3,
+        }
     }
 
     /// The vertices, in order (same winding as the input triangle).
@@ -117,54 +156,77 @@ impl ClipPolygon {
         &self.vertices[..self.len]
     }
 
-    /// Clips against the near plane, `w ≥ ε` and the guard band, interpolating the first
-    /// `varying_count` varyings linearly in clip space. The result may be empty (fewer than 3
-    /// vertices).
+    /// Clips against the near plane, the relative `w` plane and the guard band, interpolating
+    /// the first `varying_count` varyings linearly in clip space. The result may be empty
+    /// (fewer than 3 vertices); every vertex left has a finite position with `w ≥ W_MIN`.
     pub fn clip(&mut self, guard: &GuardBand, varying_count: usize) {
-        self.clip_plane(|v| v.z + v.w, varying_count);
-        self.clip_plane(|v| v.w - W_EPSILON, varying_count);
+        let n = varying_count.min(MAX_VARYINGS);
+        self.clip_plane(DVec4::new(0.0, 0.0, 1.0, 1.0), 0.0, n);
+        let w_max = self.positions[..self.len]
+            .iter()
+            .map(|p| p.w)
+            .fold(0.0f64, f64::max);
+        let w_floor = (W_RELATIVE_EPSILON * w_max).max(W_MIN as f64);
+        self.clip_plane(DVec4::new(0.0, 0.0, 0.0, 1.0), w_floor, n);
         for plane in guard.planes() {
-            self.clip_plane(|v| plane.dot(v), varying_count);
+            self.clip_plane(plane, 0.0, n);
         }
-    }
-
-    /// Sutherland–Hodgman against one plane given by its signed distance function (inside ≥ 0).
-    fn clip_plane(&mut self, distance: impl Fn(Vec4) -> f32, n: usize) {
         if self.len < 3 {
             self.len = 0;
             return;
         }
-        let src = self.vertices;
-        let count = self.len;
-        if src[..count].iter().all(|v| distance(v.pos_clip) >= 0.0) {
+        for (v, p) in self.vertices[..self.len]
+            .iter_mut()
+            .zip(&self.positions[..self.len])
+        {
+            v.pos_clip = p.as_vec4();
+            if !v.pos_clip.is_finite() || v.pos_clip.w < W_MIN {
+                self.len = 0;
+                return;
+            }
+        }
+    }
+
+    /// Sutherland–Hodgman against the plane `dot(plane, p) ≥ offset`, in `f64`.
+    fn clip_plane(&mut self, plane: DVec4, offset: f64, n: usize) {
+        if self.len < 3 {
+            self.len = 0;
             return;
         }
+        let distance = |p: DVec4| plane.dot(p) - offset;
+        let count = self.len;
+        if self.positions[..count].iter().all(|&p| distance(p) >= 0.0) {
+            return;
+        }
+        let (src, src_pos) = (self.vertices, self.positions);
         let mut out = 0;
         for i in 0..count {
-            let a = &src[i];
-            let b = &src[(i + 1) % count];
-            let da = distance(a.pos_clip);
-            let db = distance(b.pos_clip);
+            let j = (i + 1) % count;
+            let (da, db) = (distance(src_pos[i]), distance(src_pos[j]));
             if da >= 0.0 {
-                self.vertices[out] = *a;
+                self.vertices[out] = src[i];
+                self.positions[out] = src_pos[i];
                 out += 1;
             }
             if (da >= 0.0) != (db >= 0.0) {
                 // Interpolate from the inside vertex towards the outside one, so the same edge
                 // gives the same point whichever triangle it belongs to.
                 let (inner, outer, d_in, d_out) = if da >= 0.0 {
-                    (a, b, da, db)
+                    (i, j, da, db)
                 } else {
-                    (b, a, db, da)
+                    (j, i, db, da)
                 };
                 let t = d_in / (d_in - d_out);
-                let mut v = *inner;
-                v.pos_clip = inner.pos_clip + (outer.pos_clip - inner.pos_clip) * t;
+                let (p_in, p_out) = (src_pos[inner], src_pos[outer]);
+                let mut v = src[inner];
+                let (a, b) = (&src[inner].varyings, &src[outer].varyings);
                 for k in 0..n {
-                    v.varyings[k] = inner.varyings[k] + (outer.varyings[k] - inner.varyings[k]) * t;
+                    let (a, b) = (a[k] as f64, b[k] as f64);
+                    v.varyings[k] = (a + (b - a) * t) as f32;
                 }
                 if out < MAX_CLIPPED_VERTICES {
                     self.vertices[out] = v;
+                    self.positions[out] = p_in + (p_out - p_in) * t;
                     out += 1;
                 }
             }
@@ -237,13 +299,12 @@ mod tests {
         let c = vertex(0.0, 0.5, 0.0, 1.0, 0.0);
         let mut poly = ClipPolygon::triangle(a, b, c);
         poly.clip(&guard, 0);
-        // Intersections are computed in f32, so a vertex may end a hair outside a plane (here
-        // about 1e-4 relative, a couple of pixels at w ≈ 5e-4); snapping clamps to twice the
-        // guard band, which absorbs it.
+        // Intersections are computed in f64 and rounded to f32 once: at most an f32 rounding
+        // step outside a plane.
         for v in poly.vertices() {
-            assert!(v.pos_clip.w >= W_EPSILON * 0.99);
-            assert!(v.pos_clip.x.abs() <= guard.k_x * v.pos_clip.w * 1.001);
-            assert!(v.pos_clip.y.abs() <= guard.k_y * v.pos_clip.w * 1.001);
+            assert!(v.pos_clip.w >= W_MIN);
+            assert!(v.pos_clip.x.abs() <= guard.k_x * v.pos_clip.w * (1.0 + 1e-6));
+            assert!(v.pos_clip.y.abs() <= guard.k_y * v.pos_clip.w * (1.0 + 1e-6));
         }
     }
 }

@@ -9,8 +9,10 @@
 
 use rayon::prelude::*;
 
+use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::draw::{DrawCall, DrawJob};
 use super::geometry::GeometryOutput;
+use super::sanitize::zero_nan_channels;
 use super::shader::{FragmentLanes, Interpolation, Shader};
 use crate::fixed::pixel_center;
 use crate::raster::bin::TileBins;
@@ -27,6 +29,8 @@ pub(super) struct RasterCounters {
     pub(super) covered: u64,
     pub(super) shaded: u64,
     pub(super) discarded: u64,
+    /// Colour channels that were NaN and written as 0 (robust branch).
+    pub(super) nan_channels: u64,
 }
 
 impl RasterCounters {
@@ -37,6 +41,7 @@ impl RasterCounters {
             covered: a.covered + b.covered,
             shaded: a.shaded + b.shaded,
             discarded: a.discarded + b.discarded,
+            nan_channels: a.nan_channels + b.nan_channels,
         }
     }
 }
@@ -49,6 +54,7 @@ pub(super) fn raster_tiles(
     draws: &[Box<dyn DrawJob + '_>],
     strategy: Strategy,
     isa: Isa,
+    budget: &FrameBudget<'_>,
 ) -> RasterCounters {
     let grid = *framebuffer.grid();
     framebuffer
@@ -59,7 +65,11 @@ pub(super) fn raster_tiles(
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();
             let mut coverage = BlockCoverage::default();
-            for t in bins.tile(tile_index) {
+            for (k, t) in bins.tile(tile_index).enumerate() {
+                // Budget: every few triangles (robust branch).
+                if k % TRIANGLES_PER_CHECK == 0 && budget.exhausted() {
+                    break;
+                }
                 let tri = geometry.triangle(t);
                 let draw = &draws[tri.draw as usize];
                 // Early rejection: behind everything already in this tile.
@@ -226,7 +236,12 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                     lanes.load_f32(b),
                     lanes.load_f32(a),
                 ];
-                let blended = state.blend.blend_lanes(lanes, shaded.color, dst);
+                // NaN channels are written as 0 and counted, before and after blending
+                // (blending infinities can make NaN) (robust branch).
+                let (src, nan_src) = zero_nan_channels(lanes, shaded.color, keep);
+                let blended = state.blend.blend_lanes(lanes, src, dst);
+                let (blended, nan_blended) = zero_nan_channels(lanes, blended, keep);
+                counters.nan_channels += nan_src + nan_blended;
                 let [r, g, b, a] = tile.color_row_mut(index);
                 blended[0].store_masked(keep, r);
                 blended[1].store_masked(keep, g);

@@ -7,6 +7,7 @@
 use glam::Vec4;
 use rayon::prelude::*;
 
+use super::budget::FrameBudget;
 use super::draw::DrawJob;
 use crate::geometry::clip::GuardBand;
 use crate::setup::{TriangleSetup, Viewport};
@@ -135,6 +136,7 @@ pub(super) fn run_geometry(
     viewport: &Viewport,
     stats: &mut FrameStats,
     scratch: &mut GeometryScratch,
+    budget: &FrameBudget<'_>,
 ) {
     let GeometryScratch {
         shaded,
@@ -172,8 +174,17 @@ pub(super) fn run_geometry(
     }
     vertex_jobs
         .into_par_iter()
-        .for_each(|(draw, first, pos, vary)| draws[draw].shade_vertices(first, pos, vary));
+        .for_each(|(draw, first, pos, vary)| {
+            // Budget: a chunk at a time (robust branch).
+            if !budget.exhausted() {
+                draws[draw].shade_vertices(first, pos, vary);
+            }
+        });
     let shaded = &*shaded;
+    if budget.exhausted() {
+        *current_batches = 0;
+        return;
+    }
 
     // 2. Primitive stage over all draws, in chunks; results concatenated in order.
     let mut primitive_jobs = Vec::new();
@@ -204,6 +215,10 @@ pub(super) fn run_geometry(
         .zip(primitive_jobs.par_iter())
         .for_each(|(batch, &(draw, first, last))| {
             batch.clear(draws[draw].varying_count());
+            // Budget: a chunk at a time (robust branch).
+            if budget.exhausted() {
+                return;
+            }
             draws[draw].assemble(
                 draw as u32,
                 first..last,

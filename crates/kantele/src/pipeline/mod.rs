@@ -13,12 +13,16 @@
 //! Each tile is owned by one thread and processes its triangles in submission order, so the
 //! picture is identical for every thread count and traversal strategy.
 
+mod budget;
 mod draw;
 mod fragment;
 mod geometry;
+mod sanitize;
 mod shader;
 
-use std::time::Instant;
+use std::sync::atomic::AtomicBool;
+use std::sync::Arc;
+use std::time::{Duration, Instant};
 
 use glam::Vec4;
 
@@ -26,6 +30,7 @@ pub use self::draw::Indices;
 pub use self::shader::{FnShader, Fragment, FragmentLanes, ShadedLanes, Shader};
 pub use crate::state::RenderState;
 
+use self::budget::FrameBudget;
 use self::draw::{DrawCall, DrawJob};
 use self::geometry::{run_geometry, GeometryScratch};
 use crate::error::RenderError;
@@ -34,7 +39,7 @@ use crate::raster::Strategy;
 use crate::rop::Framebuffer;
 use crate::setup::{TriangleSetup, Viewport};
 use crate::simd::Isa;
-use crate::stats::FrameStats;
+use crate::stats::{FrameStats, FrameStop};
 use crate::{MAX_TARGET_SIZE, MAX_VARYINGS};
 
 /// Options of a [`Renderer`].
@@ -47,6 +52,10 @@ pub struct RendererOptions {
     /// Instruction set of the per-pixel path; `None` uses [`Isa::selected`] (the best the CPU
     /// has, or `KANTELE_ISA`). Every choice gives the same picture, bit for bit.
     pub isa: Option<Isa>,
+    /// Wall-clock budget of one frame; `None` (the default) is unlimited. A frame that runs
+    /// out stops between chunks of work, leaves the picture partly drawn and reports
+    /// [`FrameStop::TimedOut`] ([`Frame::try_end`]: [`RenderError::TimedOut`]).
+    pub timeout: Option<Duration>,
 }
 
 /// The CPU renderer: owns the framebuffer and the worker threads.
@@ -57,6 +66,8 @@ pub struct Renderer {
     isa: Isa,
     bins: TileBins,
     scratch: GeometryScratch,
+    timeout: Option<Duration>,
+    cancel: Option<Arc<AtomicBool>>,
 }
 
 impl Renderer {
@@ -78,6 +89,8 @@ impl Renderer {
             isa: resolve_isa(options.isa),
             bins: TileBins::default(),
             scratch: GeometryScratch::default(),
+            timeout: options.timeout,
+            cancel: None,
         })
     }
 
@@ -109,6 +122,24 @@ impl Renderer {
     /// instruction set this CPU lacks falls back to scalar.
     pub fn set_isa(&mut self, isa: Isa) {
         self.isa = resolve_isa(Some(isa));
+    }
+
+    /// The time budget of a frame (`None`: unlimited).
+    pub fn timeout(&self) -> Option<Duration> {
+        self.timeout
+    }
+
+    /// Changes the time budget of a frame (`None`: unlimited).
+    pub fn set_timeout(&mut self, timeout: Option<Duration>) {
+        self.timeout = timeout;
+    }
+
+    /// A flag that cancels the frame in flight (and every later one) while it is `true`: set it
+    /// from another thread or a signal handler; the frame stops between chunks of work and
+    /// reports [`FrameStop::Cancelled`]. Clear it again before the next frame. `None` removes
+    /// the flag.
+    pub fn set_cancel_flag(&mut self, flag: Option<Arc<AtomicBool>>) {
+        self.cancel = flag;
     }
 
     /// Number of worker threads.
@@ -210,7 +241,9 @@ impl<'a> Frame<'_, 'a> {
         Ok(())
     }
 
-    /// Runs every queued draw and returns what each stage did.
+    /// Runs every queued draw and returns what each stage did. A frame cut short by its time
+    /// budget or the cancellation flag returns early, with [`FrameStats::stopped`] set and the
+    /// picture partly drawn; [`Frame::try_end`] turns that into an error.
     pub fn end(self) -> FrameStats {
         let Frame {
             renderer,
@@ -231,15 +264,21 @@ impl<'a> Frame<'_, 'a> {
             isa,
             bins,
             scratch,
+            timeout,
+            cancel,
         } = renderer;
         let (strategy, isa) = (*strategy, *isa);
+        let budget = FrameBudget::new(start, *timeout, cancel.as_deref());
         pool.install(|| {
             framebuffer.clear(clear_color, clear_depth);
             let viewport = Viewport::new(framebuffer.width(), framebuffer.height());
             let geometry_start = Instant::now();
-            run_geometry(&draws, &viewport, &mut stats, scratch);
+            run_geometry(&draws, &viewport, &mut stats, scratch, &budget);
             let geometry = scratch.output();
             stats.geometry_time = geometry_start.elapsed();
+            if budget.exhausted() {
+                return;
+            }
 
             let binning_start = Instant::now();
             let grid = *framebuffer.grid();
@@ -247,18 +286,42 @@ impl<'a> Frame<'_, 'a> {
             stats.bin_entries = bins.bin_batches(&grid, &batches);
             stats.triangles_binned = batches.iter().map(|b| b.len() as u64).sum();
             stats.binning_time = binning_start.elapsed();
+            if budget.exhausted() {
+                return;
+            }
 
             let raster_start = Instant::now();
-            let counters =
-                fragment::raster_tiles(framebuffer, bins, &geometry, &draws, strategy, isa);
+            let counters = fragment::raster_tiles(
+                framebuffer,
+                bins,
+                &geometry,
+                &draws,
+                strategy,
+                isa,
+                &budget,
+            );
             stats.fragments_covered = counters.covered;
             stats.tiles_depth_rejected = counters.tile_rejected;
             stats.blocks_depth_rejected = counters.blocks_rejected;
             stats.fragments_shaded = counters.shaded;
             stats.fragments_discarded = counters.discarded;
+            stats.nan_color_channels = counters.nan_channels;
             stats.raster_time = raster_start.elapsed();
         });
+        stats.stopped = budget.stop();
+        stats.empty_picture = stats.is_unexpectedly_empty();
         stats.total_time = start.elapsed();
         stats
+    }
+
+    /// [`Frame::end`], with a frame cut short by its budget or the cancellation flag reported
+    /// as [`RenderError::TimedOut`] or [`RenderError::Cancelled`].
+    pub fn try_end(self) -> Result<FrameStats, RenderError> {
+        let stats = self.end();
+        match stats.stopped {
+            None => Ok(stats),
+            Some(FrameStop::Cancelled) => Err(RenderError::Cancelled),
+            Some(FrameStop::TimedOut { budget }) => Err(RenderError::TimedOut { budget }),
+        }
     }
 }

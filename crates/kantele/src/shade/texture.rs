@@ -460,8 +460,10 @@ fn sample_level(level: &MipLevel<'_>, sampler: &Sampler, filter: Filter, uv: Vec
             let vs = v - 0.5;
             let i0f = floor(us);
             let j0f = floor(vs);
-            let alpha = us - i0f;
-            let beta = vs - j0f;
+            // NaN or infinite coordinates (uv × size overflowing) make the fraction NaN: take
+            // the first texel of the pair instead, as NEAREST does (robust branch).
+            let alpha = defined_fraction(us - i0f);
+            let beta = defined_fraction(vs - j0f);
             let i0 = floor_to_i32(i0f);
             let j0 = floor_to_i32(j0f);
             let x0 = sampler.wrap_s.apply(i0, w) as u32;
@@ -472,6 +474,16 @@ fn sample_level(level: &MipLevel<'_>, sampler: &Sampler, filter: Filter, uv: Vec
             let bottom = level.texel(x0, y1) * (1.0 - alpha) + level.texel(x1, y1) * alpha;
             top * (1.0 - beta) + bottom * beta
         }
+    }
+}
+
+/// A bilinear weight in [0, 1], or 0 when it is not (NaN from NaN or infinite coordinates).
+#[inline]
+fn defined_fraction(f: f32) -> f32 {
+    if (0.0..=1.0).contains(&f) {
+        f
+    } else {
+        0.0
     }
 }
 
