@@ -19,13 +19,17 @@
 
 mod backends;
 mod bench;
+mod camera_args;
 mod cli;
 mod compare;
 mod compare_cmd;
+mod frame_files;
 mod info;
 mod output;
+mod output_plan;
 mod render_cmd;
 mod scenes;
+mod signals;
 mod view;
 
 use std::process::ExitCode;
@@ -73,6 +77,10 @@ fn main() -> ExitCode {
     match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(EXIT_TOLERANCE),
+        Err(e) if e.is::<signals::Interrupted>() => {
+            eprintln!("kantele: {e}");
+            ExitCode::from(signals::EXIT_INTERRUPTED)
+        }
         Err(e) => {
             eprintln!("kantele: error: {}", one_line(&format!("{e:#}")));
             ExitCode::from(EXIT_ERROR)
