@@ -36,7 +36,7 @@ pub enum Command {
 /// Which scenes to work on: files and built-in scenes.
 #[derive(Debug, Args, Clone)]
 pub struct SceneArgs {
-    /// Scene files (.gltf, .glb, .obj).
+    /// Scene files (.gltf, .glb, .obj), folders of them, or quoted patterns ("scans/*.glb").
     #[arg(value_name = "SCENE")]
     pub scenes: Vec<PathBuf>,
     /// A built-in scene (cube, teapot, ground, pixel-edges); may be repeated. Built-ins come after the files.
@@ -139,6 +139,9 @@ pub struct RenderArgs {
     /// Print one JSON line per finished image on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Skip images whose files all exist already (resume an interrupted batch).
+    #[arg(long)]
+    pub skip_existing: bool,
     /// Cameras and background.
     #[command(flatten)]
     pub camera: CameraArgs,

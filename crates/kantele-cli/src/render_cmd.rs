@@ -398,6 +398,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 
     for (input, outs) in inputs.iter().zip(&plan) {
         interrupt.check()?;
+        let done = |paths: &FramePaths| paths.color.is_some() && paths.all().all(|p| p.exists());
+        if args.skip_existing && outs.iter().all(done) {
+            progress.inc(outs.len() as u64);
+            continue;
+        }
         let label = input.label();
         progress.set_message(input.stem());
         let mut loaded = input.load()?;
@@ -422,6 +427,10 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             .map_err(|e| anyhow!("{}: {e}", job.label))?;
         for (pose, paths) in poses.iter().zip(outs) {
             interrupt.check()?;
+            if args.skip_existing && done(paths) {
+                progress.inc(1);
+                continue;
+            }
             let ms = job.render_view(backend.as_mut(), pose, paths, &interrupt)?;
             if args.json {
                 let line = json!({

@@ -394,3 +394,70 @@ fn interrupt_during_an_orbit_leaves_whole_sets_only() {
         }
     }
 }
+
+#[test]
+fn compare_out_refuses_colliding_names_before_rendering() {
+    let dir = TempDir::new("compare-out");
+    for sub in ["a", "b"] {
+        std::fs::create_dir_all(dir.path(sub)).unwrap();
+        std::fs::write(dir.path(&format!("{sub}/x.glb")), b"not a scene").unwrap();
+    }
+    let o = kantele(&[
+        "compare",
+        &dir.s("a/x.glb"),
+        &dir.s("b/x.glb"),
+        "--out",
+        &dir.s("diff"),
+    ]);
+    assert!(err_line(&o).contains("more than once"));
+    assert!(!dir.path("diff").exists(), "nothing made before the check");
+}
+
+#[test]
+fn folders_patterns_and_skip_existing() {
+    let dir = TempDir::new("batch");
+    std::fs::create_dir_all(dir.path("in")).unwrap();
+    for name in ["a", "b"] {
+        std::fs::write(
+            dir.path(&format!("in/{name}.obj")),
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+    }
+    std::fs::write(dir.path("in/notes.txt"), "not a scene").unwrap();
+    let out = dir.s("out/{stem}.png");
+    let render = |input: &str, extra: &[&str]| {
+        let mut a = vec!["render", input, "--size", "16x16", "-o", &out];
+        a.extend_from_slice(extra);
+        kantele(&a)
+    };
+    ok(&render(&dir.s("in"), &[]));
+    let listing = |d: &TempDir| {
+        let mut v: Vec<String> = std::fs::read_dir(d.path("out"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(
+        listing(&dir),
+        ["a.png", "a.png.json", "b.png", "b.png.json"]
+    );
+    // --skip-existing leaves finished images alone and makes the missing ones.
+    std::fs::remove_file(dir.path("out/b.png.json")).unwrap();
+    let before = std::fs::metadata(dir.path("out/a.png"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(20));
+    ok(&render(&dir.s("in/*.obj"), &["--skip-existing"]));
+    let after = std::fs::metadata(dir.path("out/a.png"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    assert_eq!(before, after, "a finished image was rendered again");
+    assert!(dir.path("out/b.png.json").is_file());
+    let none = render(&dir.s("in/*.gltf"), &[]);
+    assert!(err_line(&none).contains("no scene file"));
+}
