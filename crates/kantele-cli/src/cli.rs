@@ -122,8 +122,8 @@ pub struct RenderArgs {
     /// Scenes to render.
     #[command(flatten)]
     pub input: SceneArgs,
-    /// Colour output (.png: 8-bit sRGB RGBA; .exr: linear float RGBA; `-` writes the PNG to
-    /// standard output). With several scenes or views this is a template: {stem}, {index},
+    /// Colour output (.png: 8-bit sRGB RGBA; .exr: linear float RGBA; .npy: float32 (H, W, 4);
+    /// .gif/.apng: every view as one animation; `-` writes the PNG to standard output). With several scenes or views this is a template: {stem}, {index},
     /// {frame}. A JSON sidecar OUT.json is written next to each colour image (not for `-`).
     #[arg(short, long, value_name = "OUT")]
     pub output: String,
@@ -139,6 +139,9 @@ pub struct RenderArgs {
     /// Print one JSON line per finished image on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Frames per second of an animated -o (.gif, .apng).
+    #[arg(long, value_name = "N", default_value_t = 24, value_parser = clap::value_parser!(u16).range(1..=100))]
+    pub fps: u16,
     /// Skip images whose files all exist already (resume an interrupted batch).
     #[arg(long)]
     pub skip_existing: bool,
@@ -166,7 +169,7 @@ pub struct CameraArgs {
     #[arg(long, value_name = "FILE", conflicts_with = "orbit")]
     pub views: Option<PathBuf>,
     /// Render N views on a circle around the scene's bounding box, written as numbered images
-    /// ({frame}), or as one animated image when OUT is .gif or .apng.
+    /// ({frame}), or as one animated image when -o is .gif or .apng.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100000))]
     pub orbit: Option<u32>,
     /// Orbit elevation above the horizon, degrees.

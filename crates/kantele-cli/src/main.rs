@@ -17,6 +17,7 @@
 //! Errors are printed as one line, `kantele: error: …`, on stderr and exit with status 2. This
 //! crate is the only place where Kantele talks to people. The libraries return typed errors.
 
+mod animation;
 mod backends;
 mod bench;
 mod camera_args;
@@ -48,6 +49,31 @@ fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
+/// clap's usage error as one line: the problem, what is missing, and its tips ("a similar
+/// argument exists"), without the usage block.
+fn usage_error_line(text: &str) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with("Usage:") || line.starts_with("For more information") {
+            break;
+        }
+        if !line.is_empty() {
+            parts.push(line.strip_prefix("error: ").unwrap_or(line).to_string());
+        }
+    }
+    if parts.is_empty() {
+        parts.push("invalid arguments".into());
+    }
+    let mut message = parts[0].clone();
+    for p in &parts[1..] {
+        let sep = if message.ends_with(':') { " " } else { "; " };
+        message.push_str(sep);
+        message.push_str(p);
+    }
+    format!("{} (see kantele --help)", one_line(&message))
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -60,10 +86,7 @@ fn main() -> ExitCode {
             return ExitCode::from(EXIT_ERROR);
         }
         Err(e) => {
-            let text = e.to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments");
-            let first = first.strip_prefix("error: ").unwrap_or(first);
-            eprintln!("kantele: error: {} (see kantele --help)", one_line(first));
+            eprintln!("kantele: error: {}", usage_error_line(&e.to_string()));
             return ExitCode::from(EXIT_ERROR);
         }
     };
@@ -85,5 +108,27 @@ fn main() -> ExitCode {
             eprintln!("kantele: error: {}", one_line(&format!("{e:#}")));
             ExitCode::from(EXIT_ERROR)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    fn error_of(args: &[&str]) -> String {
+        usage_error_line(&Cli::try_parse_from(args).unwrap_err().to_string())
+    }
+
+    #[test]
+    fn usage_errors_keep_clap_hints() {
+        let missing = error_of(&["kantele", "render", "bunny.glb"]);
+        assert!(missing.contains("--output"), "{missing}");
+        let similar = error_of(&["kantele", "render", "x.glb", "--ouput", "a.png"]);
+        assert!(
+            similar.contains("similar argument exists: '--output'"),
+            "{similar}"
+        );
+        assert!(!missing.contains('\n') && !similar.contains("Usage"));
     }
 }

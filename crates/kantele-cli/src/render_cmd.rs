@@ -16,6 +16,7 @@ use kantele_io::pose::sidecar::{SidecarNormals, MATRIX_LAYOUT};
 use kantele_io::pose::{rows, CameraPose, Sidecar};
 use serde_json::json;
 
+use crate::animation::{is_animation, Animation, ANIMATION_TYPES};
 use crate::backends::make_backend;
 use crate::camera_args::CameraPlan;
 use crate::cli::{DepthKind, DepthUnit, NormalSpace, RenderArgs};
@@ -46,8 +47,15 @@ fn check_flags(args: &RenderArgs) -> Result<()> {
     if args.output == STDOUT && args.json {
         bail!("-o - and --json would both write to standard output; use one");
     }
-    if args.output != STDOUT {
-        files::check_type(&args.output, "-o", files::COLOR_TYPES)?;
+    if is_animation(&args.output) {
+        let e = &args.extra;
+        if e.depth.is_some() || e.normals.is_some() || !e.ids.is_empty() {
+            bail!("{}: an animation holds colour only; write depth, normals and ids with a numbered -o (.png)", args.output);
+        }
+    } else if args.output != STDOUT {
+        let mut types = files::COLOR_TYPES.to_vec();
+        types.extend_from_slice(ANIMATION_TYPES);
+        files::check_type(&args.output, "-o", &types)?;
     }
     let extra = &args.extra;
     if let Some(d) = &extra.depth {
@@ -76,6 +84,8 @@ fn plan_outputs(
     views: usize,
     guard: &mut OutputGuard,
 ) -> Result<Vec<Vec<FramePaths>>> {
+    // An animation holds every view of a scene in one file.
+    let views = if is_animation(&args.output) { 1 } else { views };
     let total = inputs.len() * views;
     let extra = &args.extra;
     let templates: Vec<&String> = std::iter::once(&args.output)
@@ -114,11 +124,14 @@ fn plan_outputs(
             } else {
                 Some(expand(&args.output)?)
             };
-            let sidecar = color.as_ref().map(|c| {
-                let mut s = c.clone().into_os_string();
-                s.push(".json");
-                PathBuf::from(s)
-            });
+            let sidecar = color
+                .as_ref()
+                .filter(|_| !is_animation(&args.output))
+                .map(|c| {
+                    let mut s = c.clone().into_os_string();
+                    s.push(".json");
+                    PathBuf::from(s)
+                });
             let paths = FramePaths {
                 color,
                 sidecar,
@@ -425,6 +438,28 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         backend
             .load(job.scene.clone())
             .map_err(|e| anyhow!("{}: {e}", job.label))?;
+        if is_animation(&args.output) {
+            let Some(path) = &outs[0].color else {
+                bail!("an animation cannot go to standard output");
+            };
+            if args.skip_existing && path.exists() {
+                progress.inc(poses.len() as u64);
+                continue;
+            }
+            let mut animation = Animation::new(width, height, args.fps);
+            for pose in &poses {
+                interrupt.check()?;
+                let view = pose.frame_view(&job.scene, Pass::Color);
+                let frame = render_pass(backend.as_mut(), &view, &job.label)?.0;
+                animation
+                    .push(&frame)
+                    .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+                progress.inc(1);
+            }
+            interrupt.check()?;
+            animation.write(path)?;
+            continue;
+        }
         for (pose, paths) in poses.iter().zip(outs) {
             interrupt.check()?;
             if args.skip_existing && done(paths) {

@@ -461,3 +461,49 @@ fn folders_patterns_and_skip_existing() {
     let none = render(&dir.s("in/*.gltf"), &[]);
     assert!(err_line(&none).contains("no scene file"));
 }
+
+#[test]
+fn orbit_straight_to_an_animation() {
+    use image::AnimationDecoder;
+    let dir = TempDir::new("turntable");
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "teapot",
+        "--size",
+        "40x30",
+        "--orbit",
+        "6",
+        "--background",
+        "transparent",
+        "-o",
+        &dir.s("spin.gif"),
+    ]);
+    ok(&o);
+    let file = std::io::BufReader::new(std::fs::File::open(dir.path("spin.gif")).unwrap());
+    let frames = image::codecs::gif::GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap();
+    assert_eq!(frames.len(), 6);
+    assert_ne!(frames[0].buffer(), frames[1].buffer(), "the views turn");
+    ok(&kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "--size",
+        "20x20",
+        "--orbit",
+        "3",
+        "-o",
+        &dir.s("spin.apng"),
+    ]));
+    let png = image::codecs::png::PngDecoder::new(std::io::BufReader::new(
+        std::fs::File::open(dir.path("spin.apng")).unwrap(),
+    ))
+    .unwrap();
+    let frames = png.apng().unwrap().into_frames().collect_frames().unwrap();
+    assert_eq!(frames.len(), 3);
+    assert_eq!(dir.files(), ["spin.apng", "spin.gif"]);
+}
