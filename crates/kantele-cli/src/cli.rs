@@ -31,6 +31,22 @@ pub enum Command {
     Compare(CompareArgs),
     /// Open a window and look at a scene with an orbit camera (CPU backend).
     View(ViewArgs),
+    /// Write a square PNG thumbnail of a scene: framed, transparent background.
+    Thumbnail(ThumbnailArgs),
+}
+
+/// `kantele thumbnail IN OUT --size N`.
+#[derive(Debug, Args)]
+pub struct ThumbnailArgs {
+    /// The scene file.
+    #[arg(value_name = "IN")]
+    pub input: PathBuf,
+    /// The PNG to write.
+    #[arg(value_name = "OUT")]
+    pub output: PathBuf,
+    /// Width and height in pixels.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub size: u32,
 }
 
 /// Which scenes to work on: files and built-in scenes.

@@ -11,6 +11,7 @@
 //!   ([`bench`](mod@bench)).
 //! - `compare` renders with several backends and measures how far the pictures differ, exiting
 //!   with 1 when a tolerance is broken ([`compare_cmd`]).
+//! - `thumbnail` writes a square PNG framed on a transparent background ([`thumbnail`]).
 //! - `view` opens a window with an orbit camera (winit + softbuffer, [`view`]).
 //!
 //! The argument definitions are in [`cli`], and backend construction is in [`backends`].
@@ -31,6 +32,8 @@ mod output_plan;
 mod render_cmd;
 mod scenes;
 mod signals;
+mod thumbnail;
+#[cfg(feature = "viewer")]
 mod view;
 
 use std::process::ExitCode;
@@ -47,6 +50,18 @@ const EXIT_TOLERANCE: u8 = 1;
 
 fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
+/// `kantele view` (needs the `viewer` feature).
+#[cfg(feature = "viewer")]
+fn run_view(args: cli::ViewArgs) -> anyhow::Result<()> {
+    view::run(args)
+}
+
+/// `kantele view` in a build without the viewer.
+#[cfg(not(feature = "viewer"))]
+fn run_view(_: cli::ViewArgs) -> anyhow::Result<()> {
+    anyhow::bail!("view: this kantele was built without the window viewer (cargo install --locked --path crates/kantele-cli --features viewer)")
 }
 
 /// clap's usage error as one line: the problem, what is missing, and its tips ("a similar
@@ -95,7 +110,8 @@ fn main() -> ExitCode {
         Command::Info(args) => info::run(&args).map(|()| true),
         Command::Bench(args) => bench::run(&args).map(|()| true),
         Command::Compare(args) => compare_cmd::run(&args),
-        Command::View(args) => view::run(args).map(|()| true),
+        Command::View(args) => run_view(args).map(|()| true),
+        Command::Thumbnail(args) => thumbnail::run(&args).map(|()| true),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,

@@ -154,7 +154,8 @@ fn plan_outputs(
     Ok(plan)
 }
 
-fn render_pass(
+/// Renders one pass and checks the frame's size.
+pub fn render_pass(
     backend: &mut dyn Backend,
     view: &FrameView,
     label: &str,

@@ -627,12 +627,14 @@ fn compare_needs_two_backends() {
 
 // ----------------------------------------------------------------------------------- viewer
 
+#[cfg(feature = "viewer")]
 fn on_path(program: &str) -> bool {
     std::env::var_os("PATH")
         .map(|p| std::env::split_paths(&p).any(|d| d.join(program).is_file()))
         .unwrap_or(false)
 }
 
+#[cfg(feature = "viewer")]
 #[test]
 fn viewer_under_xvfb() {
     if !on_path("xvfb-run") {

@@ -507,3 +507,32 @@ fn orbit_straight_to_an_animation() {
     assert_eq!(frames.len(), 3);
     assert_eq!(dir.files(), ["spin.apng", "spin.gif"]);
 }
+
+#[test]
+fn thumbnail_is_square_framed_and_transparent() {
+    let dir = TempDir::new("thumb");
+    std::fs::write(
+        dir.path("t.obj"),
+        "v 0 0 0\nv 4 0 0\nv 0 2 0\nv 4 2 0\nf 1 2 4\nf 1 4 3\n",
+    )
+    .unwrap();
+    let o = kantele(&[
+        "thumbnail",
+        &dir.s("t.obj"),
+        &dir.s("t.png"),
+        "--size",
+        "64",
+    ]);
+    ok(&o);
+    let img = image::open(dir.path("t.png")).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (64, 64));
+    assert_eq!(img.get_pixel(0, 0).0[3], 0, "transparent corner");
+    assert_eq!(img.get_pixel(32, 32).0[3], 255, "the model in the middle");
+    assert_eq!(
+        dir.files(),
+        ["t.obj", "t.png"],
+        "no sidecar, no temporaries"
+    );
+    let entry = include_str!("../data/kantele.thumbnailer");
+    assert!(entry.contains("Exec=kantele thumbnail %i %o --size %s"));
+}
