@@ -32,5 +32,32 @@ pub fn make_backend(kind: BackendKind, cpu: &CpuArgs, fast: bool) -> Result<Box<
                 "gl backend: this kantele was built without it (cargo install --locked --path crates/kantele-cli --features gl)"
             ))
         }
+        BackendKind::Cuda | BackendKind::CudaOcot | BackendKind::CudaOcmt => {
+            cuda_backend(kind, fast)
+        }
     }
+}
+
+/// The CUDA backend with the scheme `kind` names; `fast` also resolves each frame to 8-bit
+/// sRGB on the device (the counterpart of the GL backend's RGBA8 target).
+#[cfg(feature = "cuda")]
+fn cuda_backend(kind: BackendKind, fast: bool) -> Result<Box<dyn Backend>> {
+    use kantele_cuda::{CudaBackend, CudaStrategy};
+    let mut backend = CudaBackend::new().map_err(|e| anyhow!("{e}"))?;
+    backend.set_strategy(match kind {
+        BackendKind::CudaOcot => CudaStrategy::Ocot,
+        BackendKind::CudaOcmt => CudaStrategy::Ocmt,
+        _ => CudaStrategy::Tiled,
+    });
+    backend.set_resolve_rgba8(fast);
+    Ok(Box::new(backend))
+}
+
+/// Without the `cuda` feature there is no CUDA backend: one clear line.
+#[cfg(not(feature = "cuda"))]
+fn cuda_backend(kind: BackendKind, _fast: bool) -> Result<Box<dyn Backend>> {
+    anyhow::bail!(
+        "{} backend: this kantele was built without CUDA support (cargo build --features cuda)",
+        kind.name()
+    )
 }

@@ -58,6 +58,34 @@ pub struct SceneArgs {
     /// A built-in scene (cube, teapot, ground, pixel-edges); may be repeated. Built-ins come after the files.
     #[arg(long = "builtin", value_name = "NAME")]
     pub builtins: Vec<String>,
+    /// Fail on problems that are otherwise warnings (a texture file missing or undecodable).
+    #[arg(long)]
+    pub strict: bool,
+    /// Memory a scene load may use for what the file controls (vertices, indices, texels,
+    /// decoded data), e.g. 512M, 4G (default 4G); larger files are refused before allocating.
+    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
+    pub max_memory: Option<u64>,
+    /// Also let scenes read files under DIR (by default only the scene's own folder); may be
+    /// repeated.
+    #[arg(long = "allow-read", value_name = "DIR")]
+    pub allow_read: Vec<PathBuf>,
+}
+
+/// Parses a byte count with an optional K, M, G or T suffix (powers of 1024).
+pub fn parse_bytes(s: &str) -> Result<u64, String> {
+    let t = s.trim();
+    let (digits, shift) = match t.chars().last().map(|c| c.to_ascii_uppercase()) {
+        Some('K') => (&t[..t.len() - 1], 10),
+        Some('M') => (&t[..t.len() - 1], 20),
+        Some('G') => (&t[..t.len() - 1], 30),
+        Some('T') => (&t[..t.len() - 1], 40),
+        _ => (t, 0),
+    };
+    digits
+        .parse::<u64>()
+        .ok()
+        .and_then(|n| n.checked_mul(1u64 << shift))
+        .ok_or_else(|| format!("'{s}' is not a byte count (e.g. 4G, 512M, 1000000)"))
 }
 
 /// A backend by name.
@@ -67,6 +95,12 @@ pub enum BackendKind {
     Cpu,
     /// The OpenGL reference backend (headless EGL).
     Gl,
+    /// The CUDA backend: the whole tiled pipeline on an NVIDIA GPU (cargo feature `cuda`).
+    Cuda,
+    /// The CUDA backend with the thesis' "one call, one triangle" scheme (a baseline).
+    CudaOcot,
+    /// The CUDA backend with the thesis' "one call, many triangles" scheme (a baseline).
+    CudaOcmt,
 }
 
 impl BackendKind {
@@ -75,6 +109,9 @@ impl BackendKind {
         match self {
             BackendKind::Cpu => "cpu",
             BackendKind::Gl => "gl",
+            BackendKind::Cuda => "cuda",
+            BackendKind::CudaOcot => "cuda-ocot",
+            BackendKind::CudaOcmt => "cuda-ocmt",
         }
     }
 }
@@ -588,7 +625,12 @@ pub fn parse_color(s: &str) -> Result<[f32; 4], String> {
 }
 
 fn parse_strategy(s: &str) -> Result<Strategy, String> {
-    s.parse()
+    match s {
+        "ocot" | "ocmt" => Err(format!(
+            "'{s}' is a CUDA scheme: use --backend cuda-{s} (--strategy picks the CPU traversal)"
+        )),
+        _ => s.parse(),
+    }
 }
 
 fn parse_threads(s: &str) -> Result<usize, String> {

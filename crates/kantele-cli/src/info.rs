@@ -52,7 +52,11 @@ pub fn describe(loaded: &LoadedScene) -> Value {
     let textures: Vec<Value> = scene
         .textures
         .iter()
-        .map(|t| json!({ "width": t.width(), "height": t.height(), "levels": t.levels().len() }))
+        .enumerate()
+        .map(|(i, t)| {
+            let (width, height) = texture_size(loaded, i, t);
+            json!({ "width": width, "height": height, "levels": mip_levels(width, height) })
+        })
         .collect();
     let light = match scene.light {
         Light::Headlight => json!({ "kind": "headlight" }),
@@ -88,6 +92,7 @@ pub fn describe(loaded: &LoadedScene) -> Value {
         "bounding_sphere": sphere,
         "extensions_used": info.extensions_used,
         "warnings": info.warnings,
+        "ignored": info.ignored,
     })
 }
 
@@ -203,13 +208,14 @@ pub fn table(loaded: &LoadedScene) -> String {
 
     let _ = writeln!(s, "\ntextures ({})", scene.textures.len());
     for (i, t) in scene.textures.iter().enumerate() {
+        let (width, height) = texture_size(loaded, i, t);
         let _ = writeln!(
             s,
             "  {:>4}  {}x{}, {} levels",
             i,
-            t.width(),
-            t.height(),
-            t.levels().len()
+            width,
+            height,
+            mip_levels(width, height)
         );
     }
 
@@ -230,7 +236,8 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         );
     }
     for input in &inputs {
-        let loaded = input.load()?;
+        // Describing needs only the image headers: textures are not decoded.
+        let loaded = input.without_texture_decoding().load()?;
         if args.json {
             println!("{}", describe(&loaded));
         } else {
@@ -238,4 +245,24 @@ pub fn run(args: &InfoArgs) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// A texture's size: from the image header when the loader recorded it (textures are not
+/// decoded for `info`), else the texture's own.
+fn texture_size(
+    loaded: &LoadedScene,
+    index: usize,
+    texture: &kantele::shade::texture::Texture,
+) -> (u32, u32) {
+    loaded
+        .info
+        .texture_sizes
+        .get(index)
+        .copied()
+        .unwrap_or((texture.width(), texture.height()))
+}
+
+/// Levels of a full mip chain down to 1 × 1.
+fn mip_levels(width: u32, height: u32) -> u32 {
+    32 - width.max(height).max(1).leading_zeros()
 }

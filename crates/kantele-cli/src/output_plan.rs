@@ -50,7 +50,7 @@ pub fn identity(path: &Path) -> PathBuf {
 /// Files an input reads: the scene file and, for `.gltf` and `.obj`, the files it names
 /// (buffers, images, MTL libraries and their texture maps) next to it.
 pub fn input_files(input: &Input) -> Vec<PathBuf> {
-    let Input::File(path) = input else {
+    let Input::File(path, _) = input else {
         return Vec::new();
     };
     let mut files = vec![path.clone()];
@@ -217,7 +217,7 @@ mod tests {
             r#"{"asset":{"version":"2.0"},"buffers":[{"uri":"b%20in.bin"}],"images":[{"uri":"tex/a.png"},{"uri":"data:x"}]}"#,
         )
         .unwrap();
-        let input = Input::File(d.join("s.gltf"));
+        let input = Input::File(d.join("s.gltf"), Default::default());
         let files = input_files(&input);
         assert!(files.contains(&d.join("b in.bin")));
         assert!(files.contains(&d.join("tex/a.png")));
@@ -242,7 +242,7 @@ mod tests {
         let d = tmp("obj");
         std::fs::write(d.join("m.obj"), "mtllib m.mtl\nv 0 0 0\n").unwrap();
         std::fs::write(d.join("m.mtl"), "newmtl a\nmap_Kd -s 1 1 1 wood.png\n").unwrap();
-        let files = input_files(&Input::File(d.join("m.obj")));
+        let files = input_files(&Input::File(d.join("m.obj"), Default::default()));
         assert!(files.contains(&d.join("m.mtl")));
         assert!(files.contains(&d.join("wood.png")));
         std::fs::remove_dir_all(&d).unwrap();

@@ -4,15 +4,15 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
-use kantele_io::LoadedScene;
+use kantele_io::{LoadOptions, LoadedScene};
 
 use crate::cli::SceneArgs;
 
 /// One scene to load.
 #[derive(Clone, Debug)]
 pub enum Input {
-    /// A scene file.
-    File(PathBuf),
+    /// A scene file, with the options it is loaded under.
+    File(PathBuf, LoadOptions),
     /// A built-in scene by name.
     Builtin(String),
 }
@@ -21,7 +21,7 @@ impl Input {
     /// What names outputs: the file stem or the built-in's name.
     pub fn stem(&self) -> String {
         match self {
-            Input::File(p) => p
+            Input::File(p, _) => p
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| "scene".into()),
@@ -32,15 +32,32 @@ impl Input {
     /// How errors name it.
     pub fn label(&self) -> String {
         match self {
-            Input::File(p) => p.display().to_string(),
+            Input::File(p, _) => p.display().to_string(),
             Input::Builtin(n) => format!("builtin:{n}"),
+        }
+    }
+
+    /// The same input with textures left undecoded (their sizes come from the image headers):
+    /// for describing a scene.
+    pub fn without_texture_decoding(&self) -> Input {
+        match self {
+            Input::File(p, options) => Input::File(
+                p.clone(),
+                LoadOptions {
+                    decode_textures: false,
+                    ..options.clone()
+                },
+            ),
+            other => other.clone(),
         }
     }
 
     /// Loads the scene; errors name the file.
     pub fn load(&self) -> Result<LoadedScene> {
         let loaded = match self {
-            Input::File(p) => kantele_io::load_scene(p).map_err(|e| anyhow!("{e}"))?,
+            Input::File(p, options) => {
+                kantele_io::load_scene_with(p, options).map_err(|e| anyhow!("{e}"))?
+            }
             Input::Builtin(n) => {
                 kantele_io::builtin_scene(n).map_err(|e| anyhow!("{}: {e}", self.label()))?
             }
@@ -97,15 +114,22 @@ fn pattern_scenes(pattern: &str) -> Result<Vec<PathBuf>> {
 /// built-ins are known before anything is rendered.
 pub fn inputs(args: &SceneArgs) -> Result<Vec<Input>> {
     let mut out = Vec::new();
+    let options = LoadOptions {
+        max_memory: args.max_memory.unwrap_or(kantele_io::DEFAULT_MAX_MEMORY),
+        allow_read: args.allow_read.clone(),
+        strict: args.strict,
+        ..LoadOptions::default()
+    };
+    let file = |p: PathBuf| Input::File(p, options.clone());
     for p in &args.scenes {
         match std::fs::metadata(p) {
-            Ok(m) if m.is_file() => out.push(Input::File(p.clone())),
-            Ok(m) if m.is_dir() => out.extend(folder_scenes(p)?.into_iter().map(Input::File)),
+            Ok(m) if m.is_file() => out.push(file(p.clone())),
+            Ok(m) if m.is_dir() => out.extend(folder_scenes(p)?.into_iter().map(file)),
             Ok(_) => bail!("{}: not a file", p.display()),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
                 let text = p.to_string_lossy();
                 if text.contains(['*', '?', '[']) {
-                    out.extend(pattern_scenes(&text)?.into_iter().map(Input::File));
+                    out.extend(pattern_scenes(&text)?.into_iter().map(file));
                 } else {
                     bail!("{}: no such file", p.display())
                 }

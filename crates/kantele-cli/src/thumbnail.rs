@@ -15,11 +15,20 @@ use crate::scenes::{self, Input};
 
 /// Runs `kantele thumbnail`.
 pub fn run(args: &ThumbnailArgs) -> Result<()> {
-    let input = Input::File(args.input.clone());
-    scenes::inputs(&crate::cli::SceneArgs {
+    let mut found = scenes::inputs(&crate::cli::SceneArgs {
         scenes: vec![args.input.clone()],
         builtins: Vec::new(),
+        strict: false,
+        max_memory: None,
+        allow_read: Vec::new(),
     })?;
+    if found.len() != 1 {
+        anyhow::bail!(
+            "{}: a thumbnail is made of one scene file",
+            args.input.display()
+        );
+    }
+    let input: Input = found.remove(0);
     if crate::output::extension(&args.output) != "png" {
         anyhow::bail!("{}: a thumbnail is a .png", args.output.display());
     }

@@ -131,7 +131,7 @@ impl App {
     fn mode(&self) -> String {
         match self.backend_kind {
             BackendKind::Cpu => self.strategy.name().to_string(),
-            BackendKind::Gl => "gl".to_string(),
+            other => other.name().to_string(),
         }
     }
 
@@ -172,7 +172,7 @@ impl App {
                     Ok((BackendKind::Gl, b))
                 })
             }
-            BackendKind::Gl => self
+            _ => self
                 .cpu_backend(self.strategy)
                 .map(|b| (BackendKind::Cpu, b)),
         };

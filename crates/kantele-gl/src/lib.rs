@@ -111,6 +111,9 @@ struct Uniforms {
     base_color_factor: Option<glow::UniformLocation>,
     has_texture: Option<glow::UniformLocation>,
     base_color_texture: Option<glow::UniformLocation>,
+    emissive: Option<glow::UniformLocation>,
+    has_emissive_texture: Option<glow::UniformLocation>,
+    emissive_texture: Option<glow::UniformLocation>,
     unlit: Option<glow::UniformLocation>,
     alpha_mode: Option<glow::UniformLocation>,
     alpha_cutoff: Option<glow::UniformLocation>,
@@ -416,9 +419,11 @@ impl GlBackend {
             gl.uniform_1_f32(u.ambient.as_ref(), scene.ambient);
             gl.uniform_1_i32(u.pass.as_ref(), pass);
             gl.uniform_1_i32(u.base_color_texture.as_ref(), 0);
+            gl.uniform_1_i32(u.emissive_texture.as_ref(), 1);
             gl.active_texture(glow::TEXTURE0);
 
-            for (draw_index, draw) in scene.draws.iter().enumerate() {
+            for draw_index in scene.draw_order(&view.view) {
+                let draw = &scene.draws[draw_index];
                 let mesh = &scene.meshes[draw.mesh];
                 let gpu_mesh = &self.gpu.meshes[draw.mesh];
                 let material = &scene.materials[mesh.material];
@@ -476,6 +481,21 @@ impl GlBackend {
                     (draw.node_index + 1) as f32,
                     (draw_index + 1) as f32,
                 );
+                gl.uniform_3_f32_slice(u.emissive.as_ref(), &material.emissive.to_array());
+                gl.active_texture(glow::TEXTURE1);
+                match material.emissive_texture {
+                    Some(binding) => {
+                        gl.uniform_1_i32(u.has_emissive_texture.as_ref(), 1);
+                        gl.bind_texture(glow::TEXTURE_2D, Some(self.gpu.textures[binding.texture]));
+                        gl.bind_sampler(1, self.gpu.emissive_samplers[mesh.material]);
+                    }
+                    None => {
+                        gl.uniform_1_i32(u.has_emissive_texture.as_ref(), 0);
+                        gl.bind_texture(glow::TEXTURE_2D, None);
+                        gl.bind_sampler(1, None);
+                    }
+                }
+                gl.active_texture(glow::TEXTURE0);
                 match material.base_color_texture {
                     Some(binding) => {
                         gl.uniform_1_i32(u.has_texture.as_ref(), 1);
@@ -721,6 +741,9 @@ unsafe fn uniforms(gl: &glow::Context, program: glow::Program) -> Uniforms {
         base_color_factor: at("u_base_color_factor"),
         has_texture: at("u_has_texture"),
         base_color_texture: at("u_base_color_texture"),
+        emissive: at("u_emissive"),
+        has_emissive_texture: at("u_has_emissive_texture"),
+        emissive_texture: at("u_emissive_texture"),
         unlit: at("u_unlit"),
         alpha_mode: at("u_alpha_mode"),
         alpha_cutoff: at("u_alpha_cutoff"),

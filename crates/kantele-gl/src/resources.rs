@@ -25,6 +25,8 @@ pub(crate) struct GpuScene {
     pub(crate) textures: Vec<glow::Texture>,
     /// Per material: the sampler object of its base colour texture, if it has one.
     pub(crate) samplers: Vec<Option<glow::Sampler>>,
+    /// Per material: the sampler object of its emissive texture, if it has one.
+    pub(crate) emissive_samplers: Vec<Option<glow::Sampler>>,
 }
 
 /// Interleaved vertices (position, normal, texcoord, colour: [`VERTEX_FLOATS`] floats) and u32
@@ -219,6 +221,12 @@ impl GpuScene {
                     None => None,
                 };
                 gpu.samplers.push(sampler);
+                let emissive = match material.emissive_texture.map(|b| b.sampler) {
+                    // SAFETY: forwarded caller's contract.
+                    Some(s) => Some(unsafe { create_sampler(gl, &s) }?),
+                    None => None,
+                };
+                gpu.emissive_samplers.push(emissive);
             }
             Ok(())
         })();
@@ -249,6 +257,9 @@ impl GpuScene {
                 gl.delete_texture(t);
             }
             for s in self.samplers.drain(..).flatten() {
+                gl.delete_sampler(s);
+            }
+            for s in self.emissive_samplers.drain(..).flatten() {
                 gl.delete_sampler(s);
             }
         }

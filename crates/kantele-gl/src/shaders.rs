@@ -47,6 +47,9 @@ in vec4 v_color;
 uniform vec4 u_base_color_factor;
 uniform bool u_has_texture;
 uniform sampler2D u_base_color_texture;
+uniform vec3 u_emissive;        // linear emitted colour, added after lighting
+uniform bool u_has_emissive_texture;
+uniform sampler2D u_emissive_texture;
 uniform bool u_unlit;
 uniform int u_alpha_mode;      // 0 opaque, 1 mask, 2 blend
 uniform float u_alpha_cutoff;
@@ -85,6 +88,11 @@ void main() {
     vec3 rgb = base.rgb;
     if (!u_unlit) {
         rgb = base.rgb * (u_ambient + (1.0 - u_ambient) * max(0.0, dot(n, u_to_light)) * u_light_color);
+        vec3 emissive = u_emissive;
+        if (u_has_emissive_texture) {
+            emissive *= texture(u_emissive_texture, v_texcoord).rgb;
+        }
+        rgb += emissive;
     }
     float a = u_alpha_mode == 2 ? base.a : 1.0;
     o_color = vec4(rgb, a);

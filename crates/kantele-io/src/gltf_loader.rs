@@ -1,32 +1,42 @@
 //! glTF 2.0 (`.gltf` with external or embedded data, `.glb`) by the reference-scene rules.
 
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::Arc;
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use glam::{Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use kantele::scene::{AlphaMode, Camera, Draw, Light, Material, Mesh, Scene, TextureBinding};
 use kantele::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 
+use crate::accessor::{read_f32, read_u32, BufferData};
+use crate::budget::Budget;
+use crate::gltf_patch::{patch, split_glb, Patched};
 use crate::mesh_util::{
     fan_to_list, first_index_out_of_range, flat_normals, framing_camera, strip_to_list,
 };
-use crate::texture_util::decode_srgb;
-use crate::{LoadError, LoadedScene, SceneInfo};
+use crate::read_policy::{read_regular_file, ReadPolicy};
+use crate::texture_util::{decode_srgb_within, image_size, placeholder, ImageError};
+use crate::uri::read_uri;
+use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
 
 /// Extensions whose content the loader uses.
-const SUPPORTED_EXTENSIONS: &[&str] = &["KHR_lights_punctual", "KHR_materials_unlit"];
+pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
+    "KHR_lights_punctual",
+    "KHR_materials_unlit",
+    "KHR_mesh_quantization",
+    "KHR_texture_transform",
+    "KHR_materials_emissive_strength",
+    "EXT_mesh_gpu_instancing",
+    "EXT_texture_webp",
+];
 
-/// Extensions that change how geometry or images are stored: without them the file cannot be
-/// read at all, so requiring one is an error.
+/// Extensions that change how geometry or images are stored and that this loader cannot decode:
+/// requiring one is an error (using one without requiring it is refused where it is used).
 const UNREADABLE_EXTENSIONS: &[&str] = &[
     "KHR_draco_mesh_compression",
-    "KHR_mesh_quantization",
-    "EXT_meshopt_compression",
     "KHR_texture_basisu",
-    "EXT_texture_webp",
     "EXT_texture_avif",
     "MSFT_texture_dds",
 ];
@@ -34,12 +44,15 @@ const UNREADABLE_EXTENSIONS: &[&str] = &[
 /// Default image size when the scene's extras give none.
 const DEFAULT_RESOLUTION: (u32, u32) = (800, 600);
 
-/// Loads a `.gltf` or `.glb` file.
-pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
-    let bytes = std::fs::read(path).map_err(|source| LoadError::Io {
+/// Loads a `.gltf` or `.glb` file under `options`.
+pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
+    std::fs::metadata(path).map_err(|source| LoadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
+    let invalid = |m: String| LoadError::invalid(path, m);
+    let mut budget = Budget::new(options.max_memory);
+    let bytes = read_regular_file(path, &mut budget).map_err(invalid)?;
     if bytes.is_empty() {
         return Err(LoadError::invalid(path, "the file is empty"));
     }
@@ -47,107 +60,147 @@ pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
         source: path.display().to_string(),
         ..SceneInfo::default()
     };
-    let gltf::Gltf { document, blob } = gltf::Gltf::from_slice_without_validation(&bytes)
-        .map_err(|e| LoadError::invalid(path, format!("not a valid glTF file: {e}")))?;
-    let document = check_extensions(path, document, &mut info)?;
-    let buffers = load_buffers(path, &document, blob)?;
+    let (json, blob) = split_glb(&bytes).map_err(invalid)?;
+    drop(bytes);
+    let mut value: serde_json::Value = serde_json::from_slice(&json)
+        .map_err(|e| invalid(format!("not a valid glTF file: {e}")))?;
+    drop(json);
+    let patched = patch(&mut value).map_err(invalid)?;
+    for w in &patched.warnings {
+        info.warn(w.clone());
+    }
+    if patched.animations > 0 {
+        info.ignore("animations");
+    }
+    let root: gltf::json::Root = serde_json::from_value(value)
+        .map_err(|e| invalid(format!("not a valid glTF file: {e}")))?;
+    let document = check_extensions(path, root, &mut info)?;
+    let policy = ReadPolicy::new(path, &options.allow_read);
+    let buffers = load_buffers(path, &document, blob, &policy, &mut budget)?;
+    let decoded_views = HashMap::new();
     Loader {
         path,
         document: &document,
         buffers: &buffers,
+        decoded_views: &decoded_views,
+        options,
+        policy: &policy,
+        budget,
+        patched,
         scene: Scene::default(),
         info,
         image_textures: HashMap::new(),
+        encoded_images: HashMap::new(),
         primitive_meshes: HashMap::new(),
         default_material: None,
+        material_uv: Vec::new(),
     }
     .run()
 }
 
-/// Records the extensions, rejects required ones that cannot be read, and validates the document
-/// (without the unsupported required extensions, which are tried anyway with a warning).
+/// Records the extensions and validates the document. What cannot be decoded at all was
+/// refused while patching; other unsupported extensions give a warning (and the picture may
+/// lack what they add).
 fn check_extensions(
     path: &Path,
-    document: gltf::Document,
+    mut json: gltf::json::Root,
     info: &mut SceneInfo,
 ) -> Result<gltf::Document, LoadError> {
-    info.extensions_used = document.extensions_used().map(String::from).collect();
-    for ext in document.extensions_required() {
-        if UNREADABLE_EXTENSIONS.contains(&ext) {
+    info.extensions_used = json.extensions_used.clone();
+    for ext in &json.extensions_required {
+        if UNREADABLE_EXTENSIONS.contains(&ext.as_str()) {
             return Err(LoadError::invalid(
                 path,
-                format!("the file requires extension {ext}, which this loader cannot read"),
+                format!("the file requires extension {ext}, which this loader cannot decode"),
             ));
         }
-        if !SUPPORTED_EXTENSIONS.contains(&ext) {
+        if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
             info.warn(format!(
                 "the file requires unsupported extension {ext}; loading it anyway, the picture may be wrong"
             ));
         }
     }
-    for ext in &info.extensions_used.clone() {
+    for ext in &json.extensions_used {
         if !SUPPORTED_EXTENSIONS.contains(&ext.as_str()) {
-            info.warn(format!("extension {ext} is not supported and is ignored"));
+            info.ignore(ext.clone());
         }
     }
-    let mut json = document.into_json();
-    json.extensions_required
-        .retain(|e| SUPPORTED_EXTENSIONS.contains(&e.as_str()));
+    // Handled above: the crate's own list of supported extensions must not reject the file.
+    json.extensions_required.clear();
     validate(path, json, info)
 }
 
-/// Validates the document. Missing `min` / `max` on POSITION accessors (required by the spec,
-/// often left out by hand-written files, and unused here) only give a warning.
+/// Validates the document. Errors that the glTF spec allows or that this loader handles
+/// itself are let through: missing `min` / `max` on POSITION accessors (a warning), accessors
+/// without a buffer view (zero-filled) and textures without a source (drawn untextured).
 fn validate(
     path: &Path,
     json: gltf::json::Root,
     info: &mut SceneInfo,
 ) -> Result<gltf::Document, LoadError> {
-    match gltf::Document::from_json(json.clone()) {
-        Ok(document) => Ok(document),
-        Err(gltf::Error::Validation(errors)) => {
-            let harmless = |(p, e): &(gltf::json::Path, gltf::json::validation::Error)| {
-                matches!(e, gltf::json::validation::Error::Missing)
-                    && (p.0.ends_with("[\"POSITION\"].min") || p.0.ends_with("[\"POSITION\"].max"))
-            };
-            if errors.iter().all(harmless) {
-                info.warn("POSITION accessors lack the min / max the glTF spec requires");
-                Ok(gltf::Document::from_json_without_validation(json))
-            } else {
-                let list: Vec<String> = errors
-                    .iter()
-                    .filter(|e| !harmless(e))
-                    .map(|(p, e)| format!("{p}: {e}"))
-                    .collect();
-                Err(LoadError::invalid(
-                    path,
-                    format!("invalid glTF: {}", list.join("; ")),
-                ))
+    use gltf::json::validation::{Error, Validate};
+    let mut errors = Vec::new();
+    json.validate(&json, gltf::json::Path::new, &mut |p, e| {
+        errors.push((p(), e))
+    });
+    let mut min_max_missing = false;
+    let fatal: Vec<String> = errors
+        .iter()
+        .filter(|(p, e)| {
+            let p = p.as_str();
+            let missing = matches!(e, Error::Missing);
+            if missing && (p.ends_with("[\"POSITION\"].min") || p.ends_with("[\"POSITION\"].max")) {
+                min_max_missing = true;
+                return false;
             }
-        }
-        Err(e) => Err(LoadError::invalid(path, e.to_string())),
+            let handled = missing
+                && ((p.starts_with("accessors[") && p.ends_with("].bufferView"))
+                    || (p.starts_with("textures[") && p.ends_with("].source")));
+            !handled
+        })
+        .map(|(p, e)| format!("{p}: {e}"))
+        .collect();
+    if !fatal.is_empty() {
+        return Err(LoadError::invalid(
+            path,
+            format!("invalid glTF: {}", fatal.join("; ")),
+        ));
     }
+    if min_max_missing {
+        info.warn("POSITION accessors lack the min / max the glTF spec requires");
+    }
+    Ok(gltf::Document::from_json_without_validation(json))
 }
 
-/// Reads every buffer: the GLB binary chunk, external files or data URIs.
+/// Reads every buffer: the GLB binary chunk, external files or data URIs. Fallback buffers of
+/// `EXT_meshopt_compression` that have no data stay empty.
 fn load_buffers(
     path: &Path,
     document: &gltf::Document,
     mut blob: Option<Vec<u8>>,
+    policy: &ReadPolicy,
+    budget: &mut Budget,
 ) -> Result<Vec<Vec<u8>>, LoadError> {
     let mut buffers = Vec::new();
     for buffer in document.buffers() {
         let what = format!("buffer {}", buffer.index());
+        let fallback = buffer
+            .extension_value("EXT_meshopt_compression")
+            .and_then(|v| v.get("fallback"))
+            .and_then(serde_json::Value::as_bool)
+            == Some(true);
         let data = match buffer.source() {
+            gltf::buffer::Source::Bin if fallback => Vec::new(),
             gltf::buffer::Source::Bin => blob.take().ok_or_else(|| {
                 LoadError::invalid(
                     path,
                     format!("{what} refers to the binary chunk, which the file lacks"),
                 )
             })?,
-            gltf::buffer::Source::Uri(uri) => read_uri(path, uri, &what)?,
+            gltf::buffer::Source::Uri(uri) => read_uri(path, uri, policy, budget)
+                .map_err(|e| LoadError::invalid(path, format!("{what}: {e}")))?,
         };
-        if data.len() < buffer.length() {
+        if data.len() < buffer.length() && !fallback {
             return Err(LoadError::invalid(
                 path,
                 format!(
@@ -162,112 +215,78 @@ fn load_buffers(
     Ok(buffers)
 }
 
-/// Reads the data an URI refers to: a `data:` URI, or a file relative to the glTF file.
-fn read_uri(path: &Path, uri: &str, what: &str) -> Result<Vec<u8>, LoadError> {
-    if let Some(rest) = uri.strip_prefix("data:") {
-        let Some((_, payload)) = rest.split_once(";base64,") else {
-            return Err(LoadError::invalid(
-                path,
-                format!("{what}: only base64 data URIs are supported"),
-            ));
-        };
-        return decode_base64(payload).ok_or_else(|| {
-            LoadError::invalid(path, format!("{what}: the data URI is not valid base64"))
-        });
-    }
-    let file: PathBuf = if let Some(rest) = uri.strip_prefix("file://") {
-        PathBuf::from(percent_decode(rest))
-    } else if uri.contains(':') && !looks_like_windows_path(uri) {
-        return Err(LoadError::invalid(
-            path,
-            format!("{what}: unsupported URI '{uri}' (only relative files and data URIs)"),
-        ));
-    } else {
-        path.parent()
-            .unwrap_or(Path::new(""))
-            .join(percent_decode(uri))
-    };
-    std::fs::read(&file).map_err(|e| {
-        LoadError::invalid(
-            path,
-            format!("{what}: cannot read file {}: {e}", file.display()),
-        )
-    })
-}
-
-fn looks_like_windows_path(uri: &str) -> bool {
-    let b = uri.as_bytes();
-    b.len() > 2 && b[0].is_ascii_alphabetic() && b[1] == b':' && (b[2] == b'/' || b[2] == b'\\')
-}
-
-/// Decodes `%XX` escapes (URIs in glTF are percent-encoded); malformed escapes stay as they are.
-fn percent_decode(s: &str) -> String {
-    let bytes = s.as_bytes();
-    let mut out = Vec::with_capacity(bytes.len());
-    let mut i = 0;
-    while i < bytes.len() {
-        if bytes[i] == b'%' && i + 2 < bytes.len() {
-            let hex = std::str::from_utf8(&bytes[i + 1..i + 3])
-                .ok()
-                .and_then(|h| u8::from_str_radix(h, 16).ok());
-            if let Some(byte) = hex {
-                out.push(byte);
-                i += 3;
-                continue;
-            }
-        }
-        out.push(bytes[i]);
-        i += 1;
-    }
-    String::from_utf8_lossy(&out).into_owned()
-}
-
-/// Standard base64 (RFC 4648, padding optional, whitespace ignored); `None` on a bad character.
-fn decode_base64(s: &str) -> Option<Vec<u8>> {
-    fn value(c: u8) -> Option<u32> {
-        Some(match c {
-            b'A'..=b'Z' => c - b'A',
-            b'a'..=b'z' => c - b'a' + 26,
-            b'0'..=b'9' => c - b'0' + 52,
-            b'+' | b'-' => 62,
-            b'/' | b'_' => 63,
-            _ => return None,
-        } as u32)
-    }
-    let mut out = Vec::with_capacity(s.len() / 4 * 3);
-    let mut acc = 0u32;
-    let mut bits = 0;
-    for c in s.bytes() {
-        if c == b'=' {
-            break;
-        }
-        if c.is_ascii_whitespace() {
-            continue;
-        }
-        acc = (acc << 6) | value(c)?;
-        bits += 6;
-        if bits >= 8 {
-            bits -= 8;
-            out.push((acc >> bits) as u8);
-            acc &= (1 << bits) - 1;
-        }
-    }
-    Some(out)
-}
-
 /// Converts a glTF document to a [`Scene`].
 struct Loader<'a> {
     path: &'a Path,
     document: &'a gltf::Document,
     buffers: &'a [Vec<u8>],
+    /// `EXT_meshopt_compression` buffer views, decoded.
+    decoded_views: &'a HashMap<usize, Vec<u8>>,
+    options: &'a LoadOptions,
+    policy: &'a ReadPolicy,
+    budget: Budget,
+    /// What patching the JSON found (the image each texture shows).
+    patched: Patched,
     scene: Scene,
     info: SceneInfo,
-    /// glTF image index → index into `scene.textures`.
-    image_textures: HashMap<usize, usize>,
-    /// (glTF mesh, primitive) → index into `scene.meshes` (`None`: not drawable, skipped).
-    primitive_meshes: HashMap<(usize, usize), Option<usize>>,
+    /// glTF image index → index into `scene.textures` (`None`: it could not be loaded).
+    image_textures: HashMap<usize, Option<usize>>,
+    /// Encoded image bytes → index into `scene.textures`: identical sources decode once.
+    encoded_images: HashMap<Vec<u8>, usize>,
+    /// (glTF mesh, primitive, morph weights' bits) → index into `scene.meshes` (`None`: not
+    /// drawable, skipped).
+    primitive_meshes: HashMap<(usize, usize, Vec<u32>), Option<usize>>,
     /// Index of the appended default material, once one was needed.
     default_material: Option<usize>,
+    /// Per file material: the texture coordinates its textures read.
+    material_uv: Vec<Option<UvMap>>,
+}
+
+/// Which texture coordinates a material's textures read: a `TEXCOORD_n` set and a
+/// `KHR_texture_transform` (applied to the mesh's coordinates at load).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct UvMap {
+    set: u32,
+    transform: Mat3,
+}
+
+impl UvMap {
+    fn of(info: &gltf::texture::Info) -> Self {
+        let mut set = info.tex_coord();
+        let mut transform = Mat3::IDENTITY;
+        if let Some(t) = info.extension_value("KHR_texture_transform") {
+            let pair = |key: &str, default: Vec2| {
+                t.get(key)
+                    .and_then(|v| v.as_array())
+                    .and_then(|a| {
+                        Some(Vec2::new(
+                            a.first()?.as_f64()? as f32,
+                            a.get(1)?.as_f64()? as f32,
+                        ))
+                    })
+                    .unwrap_or(default)
+            };
+            let offset = pair("offset", Vec2::ZERO);
+            let scale = pair("scale", Vec2::ONE);
+            let rotation = t.get("rotation").and_then(|v| v.as_f64()).unwrap_or(0.0) as f32;
+            // uv' = T × R × S × uv. R's columns are (cos, −sin) and (sin, cos): the direction
+            // in which the sample models (TextureTransformTest, TextureTransformMultiTest) and
+            // the common viewers rotate; checked by the corpus test.
+            let (sin, cos) = rotation.sin_cos();
+            let translation = Mat3::from_cols(Vec3::X, Vec3::Y, offset.extend(1.0));
+            let rotation =
+                Mat3::from_cols(Vec3::new(cos, -sin, 0.0), Vec3::new(sin, cos, 0.0), Vec3::Z);
+            let scale = Mat3::from_diagonal(scale.extend(1.0));
+            transform = translation * rotation * scale;
+            if let Some(s) = t.get("texCoord").and_then(|v| v.as_u64()) {
+                set = s as u32;
+            }
+            if !transform.is_finite() {
+                transform = Mat3::IDENTITY;
+            }
+        }
+        Self { set, transform }
+    }
 }
 
 impl Loader<'_> {
@@ -295,12 +314,7 @@ impl Loader<'_> {
             self.scene.materials.push(converted);
         }
         if document.skins().len() > 0 {
-            self.info
-                .warn("skins are not supported; meshes are drawn in their bind pose");
-        }
-        if document.animations().len() > 0 {
-            self.info
-                .warn("animations are not supported and are ignored");
+            self.info.ignore("skins (meshes drawn in their bind pose)");
         }
 
         let Some(gltf_scene) = document
@@ -346,33 +360,46 @@ impl Loader<'_> {
                             });
                         }
                     }
-                    _ => self
-                        .info
-                        .warn("point and spot lights are not supported and are ignored"),
+                    _ => self.info.ignore("point and spot lights"),
                 }
             }
             if let Some(mesh) = node.mesh() {
-                if node.skin().is_some() || mesh.weights().is_some() {
-                    self.info
-                        .warn("skinning and morph targets are not supported; drawn without them");
+                if node.skin().is_some() {
+                    self.info.ignore("skins (meshes drawn in their bind pose)");
                 }
+                // Default morph weights: the node's, else the mesh's (the rest pose).
+                let weights: Vec<f32> = node
+                    .weights()
+                    .or(mesh.weights())
+                    .map(<[f32]>::to_vec)
+                    .unwrap_or_default();
+                let instances = self.instances(&node, world)?;
                 for primitive in mesh.primitives() {
-                    let key = (mesh.index(), primitive.index());
+                    let key = (
+                        mesh.index(),
+                        primitive.index(),
+                        weights.iter().map(|w| w.to_bits()).collect::<Vec<u32>>(),
+                    );
                     let mesh_index = match self.primitive_meshes.get(&key) {
                         Some(&m) => m,
                         None => {
-                            let m = self.primitive(&mesh, &primitive)?;
+                            let m = self.primitive(&mesh, &primitive, &weights)?;
                             self.primitive_meshes.insert(key, m);
                             m
                         }
                     };
                     if let Some(mesh_index) = mesh_index {
-                        self.scene.draws.push(Draw {
-                            mesh: mesh_index,
-                            model: world,
-                            node_name: node.name().unwrap_or_default().to_string(),
-                            node_index: index,
-                        });
+                        self.budget
+                            .charge(instances.len() as u64, 128, "the draws of a node")
+                            .map_err(|e| self.invalid(e))?;
+                        for &model in &instances {
+                            self.scene.draws.push(Draw {
+                                mesh: mesh_index,
+                                model,
+                                node_name: node.name().unwrap_or_default().to_string(),
+                                node_index: index,
+                            });
+                        }
                     }
                 }
             }
@@ -400,6 +427,78 @@ impl Loader<'_> {
             scene: self.scene,
             info: self.info,
         })
+    }
+
+    /// The model matrices a node's mesh is drawn with: its world matrix, or one per instance of
+    /// `EXT_mesh_gpu_instancing` (world × the instance's TRS).
+    fn instances(&mut self, node: &gltf::Node, world: Mat4) -> Result<Vec<Mat4>, LoadError> {
+        let Some(ext) = node.extension_value("EXT_mesh_gpu_instancing") else {
+            return Ok(vec![world]);
+        };
+        let what = format!("node {} (EXT_mesh_gpu_instancing)", node.index());
+        let attributes = ext.get("attributes").and_then(|a| a.as_object());
+        let data = BufferData {
+            buffers: self.buffers,
+            decoded_views: self.decoded_views,
+        };
+        let mut read = |name: &str, components: usize| -> Result<Option<Vec<f32>>, LoadError> {
+            let Some(index) = attributes
+                .and_then(|a| a.get(name))
+                .and_then(|v| v.as_u64())
+            else {
+                return Ok(None);
+            };
+            let accessor = self
+                .document
+                .accessors()
+                .nth(index as usize)
+                .ok_or_else(|| {
+                    LoadError::invalid(self.path, format!("{what}: no accessor {index}"))
+                })?;
+            if accessor.dimensions().multiplicity() != components {
+                return Err(LoadError::invalid(
+                    self.path,
+                    format!("{what}: {name} accessor {index} has the wrong type"),
+                ));
+            }
+            let label = format!("{what}: {name} accessor {index}");
+            read_f32(&data, &accessor, &mut self.budget, &label)
+                .map(Some)
+                .map_err(|e| LoadError::invalid(self.path, e))
+        };
+        let translation = read("TRANSLATION", 3)?;
+        let rotation = read("ROTATION", 4)?;
+        let scale = read("SCALE", 3)?;
+        let counts = [
+            translation.as_ref().map(|t| t.len() / 3),
+            rotation.as_ref().map(|r| r.len() / 4),
+            scale.as_ref().map(|s| s.len() / 3),
+        ];
+        let mut known = counts.iter().flatten();
+        let Some(&count) = known.next() else {
+            return Ok(vec![world]);
+        };
+        if known.any(|&c| c != count) {
+            return Err(self.invalid(format!(
+                "{what}: the instance attributes have different counts"
+            )));
+        }
+        let mut models =
+            crate::budget::vec_with_capacity(count, &what).map_err(|e| self.invalid(e))?;
+        for i in 0..count {
+            let t = translation
+                .as_ref()
+                .map_or(Vec3::ZERO, |t| Vec3::from_slice(&t[3 * i..]));
+            let r = rotation.as_ref().map_or(Quat::IDENTITY, |r| {
+                let q = Vec4::from_slice(&r[4 * i..]);
+                q.try_normalize().map_or(Quat::IDENTITY, Quat::from_vec4)
+            });
+            let s = scale
+                .as_ref()
+                .map_or(Vec3::ONE, |s| Vec3::from_slice(&s[3 * i..]));
+            models.push(world * Mat4::from_scale_rotation_translation(s, r, t));
+        }
+        Ok(models)
     }
 
     /// Reads `resolution`, `clear_color` and `ambient` from the scene's extras.
@@ -489,20 +588,50 @@ impl Loader<'_> {
                 })
             }
             gltf::camera::Projection::Orthographic(_) => {
-                self.info.warn(format!(
-                    "orthographic camera '{name}' is not supported; ignored"
-                ));
+                self.info.ignore(format!("orthographic camera '{name}'"));
                 None
             }
         }
     }
 
+    /// Converts a material; also records which texture coordinates its textures read
+    /// (`self.material_uv`), which the loader bakes into the meshes that use it.
     fn material(&mut self, material: &gltf::Material) -> Result<Material, LoadError> {
+        let name = named(material.name(), "material", material.index().unwrap_or(0));
         let pbr = material.pbr_metallic_roughness();
-        let base_color_texture = match pbr.base_color_texture() {
-            Some(info) => self.texture_binding(&info)?,
-            None => None,
+        let (base_color_texture, base_uv) = match pbr.base_color_texture() {
+            Some(info) => (self.texture_binding(&info)?, Some(UvMap::of(&info))),
+            None => (None, None),
         };
+        let strength = material
+            .extension_value("KHR_materials_emissive_strength")
+            .and_then(|v| v.get("emissiveStrength"))
+            .and_then(serde_json::Value::as_f64)
+            .filter(|s| s.is_finite() && *s >= 0.0)
+            .unwrap_or(1.0) as f32;
+        let mut emissive = Vec3::from(material.emissive_factor()) * strength;
+        if !emissive.is_finite() {
+            emissive = Vec3::ZERO;
+        }
+        let (mut emissive_texture, emissive_uv) = match material.emissive_texture() {
+            Some(info) => (self.texture_binding(&info)?, Some(UvMap::of(&info))),
+            None => (None, None),
+        };
+        let mut uv = base_color_texture.and(base_uv);
+        if emissive_texture.is_some() {
+            match uv {
+                None => uv = emissive_uv,
+                Some(base) if Some(base) != emissive_uv => {
+                    self.info.warn(format!(
+                        "material '{name}': the emissive texture reads other texture coordinates than the base colour texture; its emission is left out"
+                    ));
+                    emissive_texture = None;
+                    emissive = Vec3::ZERO;
+                }
+                Some(_) => {}
+            }
+        }
+        self.material_uv.push(uv);
         let alpha_mode = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => AlphaMode::Mask {
@@ -517,6 +646,8 @@ impl Loader<'_> {
             double_sided: material.double_sided(),
             alpha_mode,
             unlit: material.unlit(),
+            emissive,
+            emissive_texture,
         })
     }
 
@@ -525,24 +656,25 @@ impl Loader<'_> {
         info: &gltf::texture::Info,
     ) -> Result<Option<TextureBinding>, LoadError> {
         let texture = info.texture();
-        if info.tex_coord() != 0 {
-            self.info.warn(format!(
-                "texture {} uses TEXCOORD_{}; only TEXCOORD_0 is supported, so it is left out",
-                texture.index(),
-                info.tex_coord()
-            ));
+        let Some(image_index) = self
+            .patched
+            .texture_images
+            .get(texture.index())
+            .copied()
+            .flatten()
+        else {
             return Ok(None);
-        }
-        let image = texture.source();
-        let texture_index = match self.image_textures.get(&image.index()) {
+        };
+        let texture_index = match self.image_textures.get(&image_index) {
             Some(&t) => t,
             None => {
-                let decoded = self.image(&image)?;
-                self.scene.textures.push(Arc::new(decoded));
-                let t = self.scene.textures.len() - 1;
-                self.image_textures.insert(image.index(), t);
+                let t = self.image(image_index)?;
+                self.image_textures.insert(image_index, t);
                 t
             }
+        };
+        let Some(texture_index) = texture_index else {
+            return Ok(None);
         };
         let s = texture.sampler();
         let wrap = |mode| match mode {
@@ -580,31 +712,79 @@ impl Loader<'_> {
         }))
     }
 
-    /// Decodes one glTF image as an sRGB texture.
-    fn image(&mut self, image: &gltf::Image) -> Result<Texture, LoadError> {
-        let mut what = format!("image {}", image.index());
+    /// Loads one glTF image as an sRGB texture into the scene (once per distinct encoded
+    /// image); `None` when it is missing or cannot be decoded and the load is not strict (a
+    /// warning says so). Budget overruns are always errors.
+    fn image(&mut self, index: usize) -> Result<Option<usize>, LoadError> {
+        let Some(image) = self.document.images().nth(index) else {
+            return Ok(None);
+        };
+        let mut what = format!("image {index}");
         if let Some(name) = image.name() {
             what = format!("{what} ('{name}')");
         }
-        let (bytes, mime_type) = match image.source() {
+        let loaded = match image.source() {
             gltf::image::Source::View { view, mime_type } => {
-                let data = self
-                    .buffers
-                    .get(view.buffer().index())
-                    .and_then(|b| b.get(view.offset()..view.offset().checked_add(view.length())?))
-                    .ok_or_else(|| {
-                        self.invalid(format!("{what}: its buffer view lies outside the buffer"))
-                    })?;
-                (data.to_vec(), Some(mime_type))
+                let data = BufferData {
+                    buffers: self.buffers,
+                    decoded_views: self.decoded_views,
+                };
+                data.view(&view)
+                    .map(|b| (b.to_vec(), Some(mime_type.to_string())))
             }
             gltf::image::Source::Uri { uri, mime_type } => {
                 if !uri.starts_with("data:") {
                     what = format!("{what} from '{uri}'");
                 }
-                (read_uri(self.path, uri, &what)?, mime_type)
+                read_uri(self.path, uri, self.policy, &mut self.budget)
+                    .map(|b| (b, mime_type.map(str::to_string)))
             }
         };
-        decode_srgb(&bytes, mime_type).map_err(|e| self.invalid(format!("{what}: {e}")))
+        let (bytes, mime_type) = match loaded {
+            Ok(loaded) => loaded,
+            Err(e) if e.contains("memory budget") => {
+                return Err(self.invalid(format!("{what}: {e}")))
+            }
+            Err(e) => return self.texture_problem(format!("{what}: {e}")),
+        };
+        if let Some(&t) = self.encoded_images.get(&bytes) {
+            return Ok(Some(t));
+        }
+        let size = match image_size(&bytes, mime_type.as_deref()) {
+            Ok(size) => size,
+            Err(ImageError::Budget(e) | ImageError::Decode(e)) => {
+                return self.texture_problem(format!("{what}: {e}"))
+            }
+        };
+        if !self.options.decode_textures {
+            // Describing the scene: the header's size is reported, nothing is decoded.
+            return Ok(Some(self.push_texture(placeholder(), bytes, size)));
+        }
+        match decode_srgb_within(&bytes, mime_type.as_deref(), &mut self.budget) {
+            Ok(texture) => Ok(Some(self.push_texture(texture, bytes, size))),
+            Err(ImageError::Budget(e)) => Err(self.invalid(format!("{what}: {e}"))),
+            Err(ImageError::Decode(e)) => self.texture_problem(format!("{what}: {e}")),
+        }
+    }
+
+    fn push_texture(&mut self, texture: Texture, encoded: Vec<u8>, size: (u32, u32)) -> usize {
+        self.scene.textures.push(Arc::new(texture));
+        self.info.texture_sizes.push(size);
+        let t = self.scene.textures.len() - 1;
+        self.encoded_images.insert(encoded, t);
+        t
+    }
+
+    /// A texture that cannot be loaded: an error when strict, otherwise a warning and no
+    /// texture.
+    fn texture_problem(&mut self, message: String) -> Result<Option<usize>, LoadError> {
+        if self.options.strict {
+            return Err(self.invalid(message));
+        }
+        self.info.warn(format!(
+            "{message}; drawn untextured (--strict makes this an error)"
+        ));
+        Ok(None)
     }
 
     fn default_material(&mut self) -> usize {
@@ -619,6 +799,7 @@ impl Loader<'_> {
         &mut self,
         mesh: &gltf::Mesh,
         primitive: &gltf::Primitive,
+        weights: &[f32],
     ) -> Result<Option<usize>, LoadError> {
         let mesh_name = named(mesh.name(), "mesh", mesh.index());
         let what = format!("mesh '{mesh_name}' primitive {}", primitive.index());
@@ -632,27 +813,25 @@ impl Loader<'_> {
             ));
             return Ok(None);
         }
-        if primitive.morph_targets().len() > 0 {
-            self.info
-                .warn("skinning and morph targets are not supported; drawn without them");
-        }
-
-        let accessor_error = |semantic: &str, index: usize| {
-            format!("{what}: {semantic} accessor {index} cannot be read (it lies outside its buffer or has no data)")
+        let material = match primitive.material().index() {
+            Some(m) => m,
+            None => self.default_material(),
         };
+        let uv = self.material_uv.get(material).copied().flatten();
+        let uv_set = uv.map_or(0, |u| u.set);
+
         let check = |semantic: &str,
                      accessor: &gltf::Accessor,
-                     types: &[DataType],
-                     dims: &[Dimensions],
-                     normalized_ints: bool|
+                     allowed: &[(DataType, bool)],
+                     dims: &[Dimensions]|
          -> Result<(), LoadError> {
             let ty = accessor.data_type();
-            let ok_type = types.contains(&ty)
-                && dims.contains(&accessor.dimensions())
-                && (!normalized_ints || ty == DataType::F32 || accessor.normalized());
+            let normalized = accessor.normalized() && ty != DataType::F32;
+            let ok_type =
+                allowed.contains(&(ty, normalized)) && dims.contains(&accessor.dimensions());
             if !ok_type {
                 return Err(self.invalid(format!(
-                    "{what}: {semantic} accessor {} has type {:?} {:?}{}, which glTF does not allow",
+                    "{what}: {semantic} accessor {} has type {:?} {:?}{}, which glTF (with KHR_mesh_quantization) does not allow",
                     accessor.index(),
                     ty,
                     accessor.dimensions(),
@@ -667,6 +846,22 @@ impl Loader<'_> {
             }
             Ok(())
         };
+        use DataType::{F32, I16, I8, U16, U32, U8};
+        // Types of glTF 2.0 plus KHR_mesh_quantization, as (component type, normalized).
+        let any_int = [
+            (F32, false),
+            (I8, false),
+            (I8, true),
+            (U8, false),
+            (U8, true),
+            (I16, false),
+            (I16, true),
+            (U16, false),
+            (U16, true),
+        ];
+        let normal_types = [(F32, false), (I8, true), (I16, true)];
+        let color_types = [(F32, false), (U8, true), (U16, true)];
+        let index_types = [(U8, false), (U16, false), (U32, false)];
 
         let Some(position_accessor) = primitive.get(&Semantic::Positions) else {
             return Err(self.invalid(format!("{what} has no POSITION attribute")));
@@ -674,124 +869,136 @@ impl Loader<'_> {
         check(
             "POSITION",
             &position_accessor,
-            &[DataType::F32],
+            &any_int,
             &[Dimensions::Vec3],
-            false,
         )?;
         let normal_accessor = primitive.get(&Semantic::Normals);
         if let Some(a) = &normal_accessor {
-            check("NORMAL", a, &[DataType::F32], &[Dimensions::Vec3], false)?;
+            check("NORMAL", a, &normal_types, &[Dimensions::Vec3])?;
         }
-        let texcoord_accessor = primitive.get(&Semantic::TexCoords(0));
+        let texcoord_name = format!("TEXCOORD_{uv_set}");
+        let texcoord_accessor = primitive.get(&Semantic::TexCoords(uv_set));
         if let Some(a) = &texcoord_accessor {
-            check(
-                "TEXCOORD_0",
-                a,
-                &[DataType::F32, DataType::U8, DataType::U16],
-                &[Dimensions::Vec2],
-                true,
-            )?;
+            check(&texcoord_name, a, &any_int, &[Dimensions::Vec2])?;
         }
         let color_accessor = primitive.get(&Semantic::Colors(0));
         if let Some(a) = &color_accessor {
             check(
                 "COLOR_0",
                 a,
-                &[DataType::F32, DataType::U8, DataType::U16],
+                &color_types,
                 &[Dimensions::Vec3, Dimensions::Vec4],
-                true,
             )?;
         }
         let index_accessor = primitive.indices();
         if let Some(a) = &index_accessor {
-            check(
-                "index",
-                a,
-                &[DataType::U8, DataType::U16, DataType::U32],
-                &[Dimensions::Scalar],
-                false,
-            )?;
+            check("index", a, &index_types, &[Dimensions::Scalar])?;
         }
 
-        let buffers = self.buffers;
-        let reader = primitive.reader(|b| buffers.get(b.index()).map(Vec::as_slice));
-        let positions: Vec<Vec3> = reader
-            .read_positions()
-            .ok_or_else(|| self.invalid(accessor_error("POSITION", position_accessor.index())))?
-            .map(Vec3::from)
-            .collect();
-        let n = positions.len();
-        let count_error = |semantic: &str, len: usize| {
-            self.invalid(format!(
-                "{what}: {semantic} has {len} elements but POSITION has {n}"
-            ))
+        let data = BufferData {
+            buffers: self.buffers,
+            decoded_views: self.decoded_views,
         };
-        if n != position_accessor.count() {
-            return Err(self.invalid(accessor_error("POSITION", position_accessor.index())));
-        }
+        let n = position_accessor.count();
+        let mut read = |semantic: &str, accessor: &gltf::Accessor| {
+            let label = format!("{what}: {semantic} accessor {}", accessor.index());
+            read_f32(&data, accessor, &mut self.budget, &label)
+        };
+        let positions: Vec<Vec3> = read("POSITION", &position_accessor)
+            .map_err(|e| LoadError::invalid(self.path, e))?
+            .chunks_exact(3)
+            .map(Vec3::from_slice)
+            .collect();
+        let count_error = |semantic: &str, len: usize| {
+            LoadError::invalid(
+                self.path,
+                format!("{what}: {semantic} has {len} elements but POSITION has {n}"),
+            )
+        };
         let normals = match &normal_accessor {
-            Some(a) => {
-                let normals: Vec<Vec3> = reader
-                    .read_normals()
-                    .ok_or_else(|| self.invalid(accessor_error("NORMAL", a.index())))?
-                    .map(Vec3::from)
-                    .collect();
-                if normals.len() != n {
-                    return Err(count_error("NORMAL", normals.len()));
-                }
-                Some(normals)
-            }
+            Some(a) if a.count() != n => return Err(count_error("NORMAL", a.count())),
+            Some(a) => Some(
+                read("NORMAL", a)
+                    .map_err(|e| LoadError::invalid(self.path, e))?
+                    .chunks_exact(3)
+                    .map(Vec3::from_slice)
+                    .collect::<Vec<_>>(),
+            ),
             None => None,
         };
         let texcoords = match &texcoord_accessor {
+            Some(a) if a.count() != n => return Err(count_error(&texcoord_name, a.count())),
             Some(a) => {
-                let texcoords: Vec<Vec2> = reader
-                    .read_tex_coords(0)
-                    .ok_or_else(|| self.invalid(accessor_error("TEXCOORD_0", a.index())))?
-                    .into_f32()
-                    .map(Vec2::from)
-                    .collect();
-                if texcoords.len() != n {
-                    return Err(count_error("TEXCOORD_0", texcoords.len()));
-                }
-                Some(texcoords)
+                let transform = uv.map_or(Mat3::IDENTITY, |u| u.transform);
+                Some(
+                    read(&texcoord_name, a)
+                        .map_err(|e| LoadError::invalid(self.path, e))?
+                        .chunks_exact(2)
+                        .map(|t| transform.transform_point2(Vec2::from_slice(t)))
+                        .collect::<Vec<_>>(),
+                )
             }
             None => None,
         };
-        let colors = match &color_accessor {
-            Some(a) => {
-                let colors: Vec<Vec4> = reader
-                    .read_colors(0)
-                    .ok_or_else(|| self.invalid(accessor_error("COLOR_0", a.index())))?
-                    .into_rgba_f32()
-                    .map(Vec4::from)
-                    .collect();
-                if colors.len() != n {
-                    return Err(count_error("COLOR_0", colors.len()));
+        let (mut positions, mut normals) = (positions, normals);
+        for (target, &weight) in primitive.morph_targets().zip(weights) {
+            if weight == 0.0 || !weight.is_finite() {
+                continue;
+            }
+            let mut apply = |accessor: Option<gltf::Accessor>,
+                             values: &mut [Vec3],
+                             semantic: &str|
+             -> Result<(), LoadError> {
+                let Some(a) = accessor else { return Ok(()) };
+                if a.count() != n || a.dimensions() != Dimensions::Vec3 {
+                    return Err(count_error(semantic, a.count()));
                 }
-                Some(colors)
+                let deltas = read(semantic, &a).map_err(|e| LoadError::invalid(self.path, e))?;
+                for (v, d) in values.iter_mut().zip(deltas.chunks_exact(3)) {
+                    *v += weight * Vec3::from_slice(d);
+                }
+                Ok(())
+            };
+            apply(target.positions(), &mut positions, "morph target POSITION")?;
+            if let Some(normals) = normals.as_mut() {
+                apply(target.normals(), normals, "morph target NORMAL")?;
+            }
+        }
+        let colors = match &color_accessor {
+            Some(a) if a.count() != n => return Err(count_error("COLOR_0", a.count())),
+            Some(a) => {
+                let flat = read("COLOR_0", a).map_err(|e| LoadError::invalid(self.path, e))?;
+                Some(if a.dimensions() == Dimensions::Vec3 {
+                    flat.chunks_exact(3)
+                        .map(|c| Vec4::new(c[0], c[1], c[2], 1.0))
+                        .collect::<Vec<_>>()
+                } else {
+                    flat.chunks_exact(4).map(Vec4::from_slice).collect()
+                })
             }
             None => None,
         };
         let vertex_indices: Vec<u32> = match &index_accessor {
             Some(a) => {
-                let indices: Vec<u32> = reader
-                    .read_indices()
-                    .ok_or_else(|| self.invalid(accessor_error("index", a.index())))?
-                    .into_u32()
-                    .collect();
-                if indices.len() != a.count() {
-                    return Err(self.invalid(accessor_error("index", a.index())));
-                }
-                indices
+                let label = format!("{what}: index accessor {}", a.index());
+                read_u32(&data, a, &mut self.budget, &label)
+                    .map_err(|e| LoadError::invalid(self.path, e))?
             }
             None => {
                 let n = u32::try_from(n).map_err(|_| {
                     self.invalid(format!("{what}: too many vertices for 32-bit indices"))
                 })?;
+                self.budget
+                    .charge(n as u64, 4, &what)
+                    .map_err(|e| LoadError::invalid(self.path, e))?;
                 (0..n).collect()
             }
         };
+        if positions.iter().any(|p| !p.is_finite()) {
+            self.info.warn(format!(
+                "{what}: some positions are infinite or NaN; triangles using them are not drawn"
+            ));
+        }
         let indices = match mode {
             Mode::TriangleStrip => strip_to_list(&vertex_indices),
             Mode::TriangleFan => fan_to_list(&vertex_indices),
@@ -810,10 +1017,6 @@ impl Loader<'_> {
                 "{what}: index {index} at position {position} is out of range for {n} vertices"
             )));
         }
-        let material = match primitive.material().index() {
-            Some(m) => m,
-            None => self.default_material(),
-        };
         let mut converted = Mesh {
             name: mesh_name,
             positions,
@@ -836,27 +1039,5 @@ fn named(name: Option<&str>, kind: &str, index: usize) -> String {
     match name {
         Some(n) if !n.is_empty() => n.to_string(),
         _ => format!("{kind} {index}"),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn base64_round_trip() {
-        assert_eq!(decode_base64("aGVsbG8=").unwrap(), b"hello");
-        assert_eq!(decode_base64("aGVsbG8").unwrap(), b"hello");
-        assert_eq!(decode_base64("AAECAwQF").unwrap(), vec![0, 1, 2, 3, 4, 5]);
-        assert_eq!(decode_base64("").unwrap(), Vec::<u8>::new());
-        assert!(decode_base64("a*b").is_none());
-    }
-
-    #[test]
-    fn percent_decoding() {
-        assert_eq!(percent_decode("my%20file.png"), "my file.png");
-        assert_eq!(percent_decode("100%"), "100%");
-        assert_eq!(percent_decode("%zz%4"), "%zz%4");
-        assert_eq!(percent_decode("%C3%A4.bin"), "ä.bin");
     }
 }

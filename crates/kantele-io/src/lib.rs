@@ -37,13 +37,21 @@ use std::path::{Path, PathBuf};
 use kantele::scene::Scene;
 use thiserror::Error;
 
+mod accessor;
+mod budget;
 mod builtin;
+mod ear_clip;
 mod gltf_loader;
+mod gltf_patch;
 pub mod mesh_util;
 mod obj_loader;
+mod obj_text;
 pub mod output;
 pub mod pose;
+mod quiet_panic;
+mod read_policy;
 mod texture_util;
+mod uri;
 
 pub use mesh_util::flat_normals;
 
@@ -72,7 +80,13 @@ pub struct SceneInfo {
     /// Extensions the file uses.
     pub extensions_used: Vec<String>,
     /// Problems that did not stop loading (unsupported but harmless features, ...), once each.
+    /// Features the file uses that are not drawn are listed together in one of them.
     pub warnings: Vec<String>,
+    /// Width and height of each texture of the scene, as its image header declares them
+    /// (also when textures were not decoded).
+    pub texture_sizes: Vec<(u32, u32)>,
+    /// Features the file uses that are ignored (extensions, animations, skins, ...), once each.
+    pub ignored: Vec<String>,
 }
 
 impl SceneInfo {
@@ -81,6 +95,25 @@ impl SceneInfo {
         let message = message.into();
         if !self.warnings.contains(&message) {
             self.warnings.push(message);
+        }
+    }
+
+    /// Records a feature of the file that is ignored (reported in one warning line).
+    pub(crate) fn ignore(&mut self, feature: impl Into<String>) {
+        let feature = feature.into();
+        if !self.ignored.contains(&feature) {
+            self.ignored.push(feature);
+        }
+    }
+
+    /// Adds the one warning line that names every ignored feature.
+    pub(crate) fn finish(&mut self) {
+        if !self.ignored.is_empty() {
+            let line = format!(
+                "ignored (not drawn or not applied): {}",
+                self.ignored.join(", ")
+            );
+            self.warn(line);
         }
     }
 }
@@ -125,38 +158,80 @@ impl LoadError {
     }
 }
 
-/// Loads a scene file, choosing the format by extension (`.gltf`, `.glb`, `.obj`).
+/// Default memory budget of a load: 4 GiB.
+pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
+
+/// What a load may do: its memory budget, where it may read, and whether problems that can be
+/// worked around (a missing texture file) are errors.
+#[derive(Clone, Debug)]
+pub struct LoadOptions {
+    /// Bytes the load may allocate for what the file controls (vertices, indices, texels,
+    /// decoded images and buffers), checked by arithmetic before each allocation; a file that
+    /// needs more is refused with an error. Default [`DEFAULT_MAX_MEMORY`].
+    pub max_memory: u64,
+    /// Folders, besides the scene file's own folder, from which the scene may read files.
+    /// Only regular files are ever read (no devices, FIFOs or folders), after resolving `..`
+    /// and symbolic links.
+    pub allow_read: Vec<PathBuf>,
+    /// Turn recoverable problems (a texture file that is missing or cannot be decoded) into
+    /// errors instead of warnings.
+    pub strict: bool,
+    /// Decode textures (default). Without it, each image's header is read and a placeholder of
+    /// its size stands in for it: for describing a scene without paying for its pixels.
+    pub decode_textures: bool,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        Self {
+            max_memory: DEFAULT_MAX_MEMORY,
+            allow_read: Vec::new(),
+            strict: false,
+            decode_textures: true,
+        }
+    }
+}
+
+/// Loads a scene file with the default [`LoadOptions`], choosing the format by extension
+/// (`.gltf`, `.glb`, `.obj`).
 ///
 /// Malformed input of any kind gives an error naming the file; the loader does not panic.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadError> {
+    load_scene_with(path, &LoadOptions::default())
+}
+
+/// Loads a scene file under the given options (memory budget, read policy, strictness).
+///
+/// Malformed input of any kind gives an error naming the file; the loader does not panic and
+/// does not allocate beyond `options.max_memory` for what the file controls.
+pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
     let extension = path
         .extension()
         .and_then(|e| e.to_str())
         .map(str::to_ascii_lowercase);
-    let loader: fn(&Path) -> Result<LoadedScene, LoadError> = match extension.as_deref() {
-        Some("gltf") | Some("glb") => gltf_loader::load,
-        Some("obj") => obj_loader::load,
-        _ => {
-            return Err(LoadError::UnknownFormat {
-                path: path.to_path_buf(),
-            })
-        }
-    };
+    let loader: fn(&Path, &LoadOptions) -> Result<LoadedScene, LoadError> =
+        match extension.as_deref() {
+            Some("gltf") | Some("glb") => gltf_loader::load,
+            Some("obj") => obj_loader::load,
+            _ => {
+                return Err(LoadError::UnknownFormat {
+                    path: path.to_path_buf(),
+                })
+            }
+        };
     // The parsing crates are defensive but not panic-free on every malformed input (unchecked
-    // `unreachable!`s, arithmetic on counts); a panic there must become an error, not a crash.
-    match std::panic::catch_unwind(|| loader(path)) {
-        Ok(result) => result,
-        Err(panic) => {
-            let what = panic
-                .downcast_ref::<&str>()
-                .map(|s| s.to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
-                .unwrap_or_else(|| "unknown error".to_string());
-            Err(LoadError::invalid(
-                path,
-                format!("malformed file (the parser failed: {what})"),
-            ))
+    // `unreachable!`s, arithmetic on counts); a panic there must become a one-line error, not a
+    // crash or a backtrace on stderr.
+    match quiet_panic::catch(|| loader(path, options)) {
+        Ok(Ok(mut loaded)) => {
+            loaded.info.finish();
+            Ok(loaded)
         }
+        Ok(Err(e)) => Err(e),
+        Err(what) => Err(LoadError::invalid(
+            path,
+            format!("malformed file (the parser failed: {what})"),
+        )),
     }
 }
 

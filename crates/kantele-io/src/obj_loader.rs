@@ -1,41 +1,106 @@
 //! Wavefront OBJ with MTL materials.
 
+use std::cell::RefCell;
 use std::collections::HashMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use kantele::scene::{AlphaMode, Draw, Light, Material, Mesh, Scene, TextureBinding};
+use kantele::shade::texture::Texture;
 
+use crate::budget::Budget;
+use crate::ear_clip::triangulate;
 use crate::mesh_util::{first_index_out_of_range, flat_normals, framing_camera};
-use crate::texture_util::{decode_srgb, trilinear_repeat};
-use crate::{LoadError, LoadedScene, SceneInfo};
+use crate::obj_text::{patch_mtl, patch_obj, text, texture_file_name, UNNAMED_MATERIAL};
+use crate::read_policy::{read_regular_file, ReadPolicy};
+use crate::texture_util::{
+    decode_srgb_within, image_size, placeholder, trilinear_repeat, ImageError,
+};
+use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
+
+/// Bytes of memory charged per byte of OBJ text before parsing: the parser's vertices (with
+/// one vertex per distinct corner), indices and the flat-shaded copy stay within this.
+const OBJ_BYTES_PER_TEXT_BYTE: u64 = 32;
 
 /// Loads an `.obj` file and the materials of its `.mtl` libraries.
-pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
-    // tobj reports a missing file only as "open file failed": look first, for a proper message.
+pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
     std::fs::metadata(path).map_err(|source| LoadError::Io {
         path: path.to_path_buf(),
         source,
     })?;
-    let options = tobj::LoadOptions {
-        triangulate: true,
+    let mut budget = Budget::new(options.max_memory);
+    let bytes = read_regular_file(path, &mut budget).map_err(|e| LoadError::invalid(path, e))?;
+    budget
+        .charge(
+            bytes.len() as u64,
+            OBJ_BYTES_PER_TEXT_BYTE,
+            "parsing the OBJ text",
+        )
+        .map_err(|e| LoadError::invalid(path, e))?;
+    let patched = patch_obj(&text(&bytes));
+    drop(bytes);
+    let policy = ReadPolicy::new(path, &options.allow_read);
+    let directory = path.parent().unwrap_or(Path::new("")).to_path_buf();
+    // The MTL loader runs inside tobj (a `Fn`): what it needs to change goes through cells.
+    let budget = RefCell::new(budget);
+    let material_dirs: RefCell<Vec<PathBuf>> = RefCell::new(Vec::new());
+    let mtl_warnings: RefCell<Vec<String>> = RefCell::new(Vec::new());
+    let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
+        let file = directory.join(name.to_string_lossy().replace('\\', "/"));
+        let bytes = policy.read(&file, &mut budget.borrow_mut()).map_err(|e| {
+            mtl_warnings
+                .borrow_mut()
+                .push(format!("material library {}: {e}", name.display()));
+            tobj::LoadError::OpenFileFailed
+        })?;
+        let (mtl, warnings) = patch_mtl(&text(&bytes));
+        for w in warnings {
+            mtl_warnings
+                .borrow_mut()
+                .push(format!("material library {}: {w}", name.display()));
+        }
+        let result = tobj::load_mtl_buf(&mut std::io::Cursor::new(mtl.as_bytes()));
+        if let Ok((materials, _)) = &result {
+            let dir = file.parent().unwrap_or(Path::new("")).to_path_buf();
+            material_dirs
+                .borrow_mut()
+                .extend(std::iter::repeat_n(dir, materials.len()));
+        }
+        result
+    };
+    let tobj_options = tobj::LoadOptions {
+        triangulate: false,
         single_index: true,
         ..Default::default()
     };
-    let (models, materials) = tobj::load_obj(path, &options)
-        .map_err(|e| LoadError::invalid(path, format!("not a valid OBJ file: {e}")))?;
+    let (models, materials) = tobj::load_obj_buf(
+        &mut std::io::Cursor::new(patched.text.as_bytes()),
+        &tobj_options,
+        load_mtl,
+    )
+    .map_err(|e| LoadError::invalid(path, format!("not a valid OBJ file: {e}")))?;
+    let mut budget = budget.into_inner();
+    let material_dirs = material_dirs.into_inner();
     let mut info = SceneInfo {
         source: path.display().to_string(),
         node_count: models.len(),
         ..SceneInfo::default()
     };
+    for w in mtl_warnings.into_inner() {
+        info.warn(w);
+    }
+    if patched.lines > 0 {
+        info.ignore(format!("{} line statements (l)", patched.lines));
+    }
+    if patched.points > 0 {
+        info.ignore(format!("{} point statements (p)", patched.points));
+    }
     let mut scene = Scene {
         light: Light::Headlight,
         resolution: (800, 600),
         ..Scene::default()
     };
-    let directory = path.parent().unwrap_or(Path::new(""));
     let materials = match materials {
         Ok(m) => m,
         Err(e) => {
@@ -45,36 +110,41 @@ pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
             Vec::new()
         }
     };
-    let mut texture_files: HashMap<String, usize> = HashMap::new();
-    for m in &materials {
-        let base_color_texture = match m.diffuse_texture.as_deref().map(str::trim) {
+    let mut texture_files: HashMap<PathBuf, Option<usize>> = HashMap::new();
+    for (material_index, m) in materials.iter().enumerate() {
+        let base_color_texture = match m.diffuse_texture.as_deref().map(texture_file_name) {
             Some(name) if !name.is_empty() => {
-                let texture = match texture_files.get(name) {
+                // Relative to the folder of the MTL file that names it.
+                let folder = material_dirs.get(material_index).unwrap_or(&directory);
+                let file = folder.join(name.replace('\\', "/"));
+                let texture = match texture_files.get(&file) {
                     Some(&t) => t,
                     None => {
-                        let file = directory.join(name.replace('\\', "/"));
-                        let bytes = std::fs::read(&file).map_err(|e| {
-                            LoadError::invalid(
-                                path,
-                                format!(
-                                    "material '{}': cannot read texture {}: {e}",
-                                    m.name,
-                                    file.display()
-                                ),
-                            )
-                        })?;
-                        let decoded = decode_srgb(&bytes, None).map_err(|e| {
-                            LoadError::invalid(
-                                path,
-                                format!("material '{}': texture {}: {e}", m.name, file.display()),
-                            )
-                        })?;
-                        scene.textures.push(Arc::new(decoded));
-                        texture_files.insert(name.to_string(), scene.textures.len() - 1);
-                        scene.textures.len() - 1
+                        let what = format!("material '{}': texture {}", m.name, file.display());
+                        let t = match load_texture(&file, &policy, &mut budget, options) {
+                            Ok(texture) => {
+                                scene.textures.push(Arc::new(texture.0));
+                                info.texture_sizes.push(texture.1);
+                                Some(scene.textures.len() - 1)
+                            }
+                            Err(ImageError::Budget(e)) => {
+                                return Err(LoadError::invalid(path, format!("{what}: {e}")))
+                            }
+                            Err(ImageError::Decode(e)) if options.strict => {
+                                return Err(LoadError::invalid(path, format!("{what}: {e}")))
+                            }
+                            Err(ImageError::Decode(e)) => {
+                                info.warn(format!(
+                                    "{what}: {e}; drawn untextured (--strict makes this an error)"
+                                ));
+                                None
+                            }
+                        };
+                        texture_files.insert(file.clone(), t);
+                        t
                     }
                 };
-                Some(TextureBinding {
+                texture.map(|texture| TextureBinding {
                     texture,
                     sampler: trilinear_repeat(),
                 })
@@ -88,13 +158,19 @@ pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
         } else {
             (1.0, AlphaMode::Opaque)
         };
+        let name = if m.name == UNNAMED_MATERIAL {
+            String::new()
+        } else {
+            m.name.clone()
+        };
         scene.materials.push(Material {
-            name: m.name.clone(),
+            name,
             base_color_factor: Vec4::new(diffuse[0], diffuse[1], diffuse[2], alpha),
             base_color_texture,
             double_sided: false,
             alpha_mode,
             unlit: false,
+            ..Material::default()
         });
     }
     let mut default_material = None;
@@ -135,18 +211,22 @@ pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
                 .map(|c| Vec4::new(c[0], c[1], c[2], 1.0))
                 .collect::<Vec<_>>()
         });
-        if m.indices.len() % 3 != 0 {
-            return Err(LoadError::invalid(
-                path,
-                format!("{what}: the faces do not make whole triangles"),
-            ));
-        }
         if let Some((position, index)) = first_index_out_of_range(&m.indices, n) {
             return Err(LoadError::invalid(
                 path,
                 format!(
                     "{what}: index {index} at position {position} is out of range for {n} vertices"
                 ),
+            ));
+        }
+        let indices = triangulate_faces(&m.indices, &m.face_arities, &positions, &mut budget)
+            .map_err(|e| LoadError::invalid(path, format!("{what}: {e}")))?;
+        if indices.is_empty() {
+            continue;
+        }
+        if positions.iter().any(|p| !p.is_finite()) {
+            info.warn(format!(
+                "{what}: some positions are infinite or NaN; faces using them are not drawn"
             ));
         }
         let material = match m.material_id {
@@ -169,7 +249,7 @@ pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
             normals,
             texcoords,
             colors,
-            indices: m.indices.clone(),
+            indices,
             material,
         };
         if mesh.normals.is_none() {
@@ -191,4 +271,71 @@ pub fn load(path: &Path) -> Result<LoadedScene, LoadError> {
         .validate()
         .map_err(|e| LoadError::invalid(path, e.to_string()))?;
     Ok(LoadedScene { scene, info })
+}
+
+/// Reads and decodes a texture file under the read policy and budget (a placeholder when
+/// textures are not decoded); with its header size.
+fn load_texture(
+    file: &Path,
+    policy: &ReadPolicy,
+    budget: &mut Budget,
+    options: &LoadOptions,
+) -> Result<(Texture, (u32, u32)), ImageError> {
+    let bytes = policy.read(file, budget).map_err(|e| {
+        if e.contains("memory budget") {
+            ImageError::Budget(e)
+        } else {
+            ImageError::Decode(e)
+        }
+    })?;
+    let size = image_size(&bytes, None)?;
+    if !options.decode_textures {
+        return Ok((placeholder(), size));
+    }
+    Ok((decode_srgb_within(&bytes, None, budget)?, size))
+}
+
+/// Triangles of the faces (`arities` corners each; empty means all triangles): polygons by ear
+/// clipping, so concave ones keep their shape; faces of one or two corners are dropped.
+fn triangulate_faces(
+    indices: &[u32],
+    arities: &[u32],
+    positions: &[Vec3],
+    budget: &mut Budget,
+) -> Result<Vec<u32>, String> {
+    if arities.is_empty() {
+        if indices.len() % 3 != 0 {
+            return Err("the faces do not make whole triangles".to_string());
+        }
+        return Ok(indices.to_vec());
+    }
+    let corners: u64 = arities.iter().map(|&a| a as u64).sum();
+    if corners != indices.len() as u64 {
+        return Err("the face sizes do not match the indices".to_string());
+    }
+    // A polygon of k corners makes k − 2 triangles: at most 3 indices per corner.
+    budget.charge(corners, 12, "triangulating the faces")?;
+    let mut out = crate::budget::vec_with_capacity(indices.len() * 3, "triangulating the faces")?;
+    let mut start = 0;
+    for &arity in arities {
+        let face = &indices[start..start + arity as usize];
+        start += arity as usize;
+        if face.len() < 3 {
+            continue;
+        }
+        let corners: Vec<Vec3> = face.iter().map(|&i| positions[i as usize]).collect();
+        match triangulate(&corners) {
+            Some(triangles) => {
+                for t in triangles {
+                    out.extend(t.iter().map(|&k| face[k]));
+                }
+            }
+            None => {
+                for k in 1..face.len() - 1 {
+                    out.extend([face[0], face[k], face[k + 1]]);
+                }
+            }
+        }
+    }
+    Ok(out)
 }

@@ -2,22 +2,105 @@
 
 use kantele::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
 
-/// Decodes an encoded PNG or JPEG image into an sRGB texture with its mip chain. `mime_type`
-/// picks the decoder when given; otherwise the format is guessed from the data.
-pub fn decode_srgb(bytes: &[u8], mime_type: Option<&str>) -> Result<Texture, String> {
-    let format = match mime_type {
+use crate::budget::Budget;
+
+/// Bytes of memory a decoded texture keeps per texel: `f32` RGBA plus its mip chain (4/3).
+const TEXTURE_BYTES_PER_TEXEL: u64 = 16 * 4 / 3 + 1;
+
+/// Why an image did not become a texture.
+#[derive(Debug)]
+pub(crate) enum ImageError {
+    /// It would exceed the load's memory budget (always an error).
+    Budget(String),
+    /// It is not an image this loader can decode (a missing texture may be tolerated).
+    Decode(String),
+}
+
+fn image_format(mime_type: Option<&str>) -> Option<image::ImageFormat> {
+    match mime_type {
         Some("image/png") => Some(image::ImageFormat::Png),
         Some("image/jpeg") | Some("image/jpg") => Some(image::ImageFormat::Jpeg),
+        Some("image/webp") => Some(image::ImageFormat::WebP),
         _ => None,
-    };
-    let decoded = match format {
-        Some(format) => image::load_from_memory_with_format(bytes, format),
-        None => image::load_from_memory(bytes),
     }
-    .map_err(|e| format!("cannot decode image: {e}"))?;
+}
+
+fn reader<'a>(
+    bytes: &'a [u8],
+    mime_type: Option<&str>,
+) -> Result<image::ImageReader<std::io::Cursor<&'a [u8]>>, ImageError> {
+    let cursor = std::io::Cursor::new(bytes);
+    let mut reader = image::ImageReader::new(cursor);
+    match image_format(mime_type) {
+        Some(format) => reader.set_format(format),
+        None => {
+            reader = reader
+                .with_guessed_format()
+                .map_err(|e| ImageError::Decode(format!("cannot decode image: {e}")))?
+        }
+    }
+    Ok(reader)
+}
+
+/// The image's size from its header alone (nothing is decoded).
+pub(crate) fn image_size(bytes: &[u8], mime_type: Option<&str>) -> Result<(u32, u32), ImageError> {
+    reader(bytes, mime_type)?
+        .into_dimensions()
+        .map_err(|e| ImageError::Decode(format!("cannot decode image: {e}")))
+}
+
+/// Decodes an encoded PNG, JPEG or WebP image into an sRGB texture with its mip chain, after
+/// reading its size from the header and charging the texture's memory to `budget`. `mime_type`
+/// picks the decoder when given; otherwise the format is guessed from the data.
+pub(crate) fn decode_srgb_within(
+    bytes: &[u8],
+    mime_type: Option<&str>,
+    budget: &mut Budget,
+) -> Result<Texture, ImageError> {
+    let (width, height) = image_size(bytes, mime_type)?;
+    let max = kantele::shade::texture::MAX_TEXTURE_SIZE;
+    if width == 0 || height == 0 || width > max || height > max {
+        return Err(ImageError::Decode(format!(
+            "image size {width}x{height} is outside 1..={max}"
+        )));
+    }
+    budget
+        .charge(
+            width as u64 * height as u64,
+            TEXTURE_BYTES_PER_TEXEL,
+            &format!("a {width}x{height} texture"),
+        )
+        .map_err(ImageError::Budget)?;
+    let mut reader = reader(bytes, mime_type)?;
+    let mut limits = image::Limits::default();
+    limits.max_image_width = Some(width);
+    limits.max_image_height = Some(height);
+    // The decoder's own buffers: at most 16-bit RGBA, plus the 8-bit copy.
+    limits.max_alloc = Some(width as u64 * height as u64 * 12 + (1 << 20));
+    reader.limits(limits);
+    let decoded = reader
+        .decode()
+        .map_err(|e| ImageError::Decode(format!("cannot decode image: {e}")))?;
     let rgba = decoded.to_rgba8();
+    drop(decoded);
     Texture::from_rgba8(rgba.width(), rgba.height(), rgba.as_raw(), ColorSpace::Srgb)
-        .map_err(|e| e.to_string())
+        .map_err(|e| ImageError::Decode(e.to_string()))
+}
+
+/// Decodes an encoded PNG, JPEG or WebP image into an sRGB texture with its mip chain, within
+/// the default memory budget.
+#[cfg(test)]
+fn decode_srgb(bytes: &[u8], mime_type: Option<&str>) -> Result<Texture, String> {
+    let mut budget = Budget::new(crate::DEFAULT_MAX_MEMORY);
+    decode_srgb_within(bytes, mime_type, &mut budget).map_err(|e| match e {
+        ImageError::Budget(m) | ImageError::Decode(m) => m,
+    })
+}
+
+/// A 1 × 1 white stand-in for an image that is not decoded (scene descriptions).
+pub(crate) fn placeholder() -> Texture {
+    Texture::from_rgba8(1, 1, &[255; 4], ColorSpace::Srgb)
+        .expect("a 1x1 texture with 4 bytes is valid")
 }
 
 /// The sampler most scenes want: REPEAT, bilinear magnification, trilinear minification.

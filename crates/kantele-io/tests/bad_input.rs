@@ -5,7 +5,7 @@ mod common;
 use std::path::Path;
 
 use common::*;
-use kantele_io::{load_scene, LoadError};
+use kantele_io::{load_scene, load_scene_with, LoadError, LoadOptions};
 use serde_json::json;
 
 /// Loads `path`, expecting an error whose message names the file (and contains `expected`).
@@ -20,6 +20,41 @@ fn expect_error(path: &Path, expected: &str) -> String {
         err.to_lowercase().contains(&expected.to_lowercase()),
         "error lacks '{expected}': {err}"
     );
+    err
+}
+
+/// A texture that cannot be loaded: by default the scene loads with a warning naming
+/// `expected` and the material drawn untextured; with `strict` it is an error naming the file.
+fn expect_texture_problem(path: &Path, expected: &str) -> String {
+    let loaded = load_scene(path).unwrap_or_else(|e| panic!("{} should load: {e}", path.display()));
+    assert!(
+        loaded
+            .info
+            .warnings
+            .iter()
+            .any(|w| w.contains(expected) && w.contains("untextured")),
+        "no warning naming {expected}: {:?}",
+        loaded.info.warnings
+    );
+    assert!(
+        loaded
+            .scene
+            .materials
+            .iter()
+            .all(|m| m.base_color_texture.is_none()),
+        "the material keeps a texture"
+    );
+    let strict = LoadOptions {
+        strict: true,
+        ..LoadOptions::default()
+    };
+    let err = load_scene_with(path, &strict)
+        .err()
+        .unwrap_or_else(|| panic!("{} should not load when strict", path.display()))
+        .to_string();
+    let name = path.file_name().unwrap().to_str().unwrap();
+    assert!(err.contains(name), "error does not name {name}: {err}");
+    assert!(err.contains(expected), "error lacks '{expected}': {err}");
     err
 }
 
@@ -229,7 +264,7 @@ fn missing_external_files() {
     g.write_gltf_external(&path);
     // Missing texture.
     std::fs::remove_file(dir.join("quad-image0.png")).unwrap();
-    let err = expect_error(&path, "quad-image0.png");
+    let err = expect_texture_problem(&path, "quad-image0.png");
     assert!(err.contains("image 0"), "{err}");
     // Missing buffer.
     std::fs::remove_file(dir.join("quad.bin")).unwrap();
@@ -245,17 +280,17 @@ fn corrupt_textures() {
     g.images[0] = broken;
     let path = dir.join("corrupt.gltf");
     g.write_gltf_external(&path);
-    let err = expect_error(&path, "corrupt-image0.png");
+    let err = expect_texture_problem(&path, "corrupt-image0.png");
     assert!(err.contains("image 0"), "{err}");
     // Not an image at all, inside a GLB.
     g.images[0] = b"this is not a png".to_vec();
     let path = dir.join("corrupt.glb");
     g.write_glb(&path);
-    expect_error(&path, "image 0");
+    expect_texture_problem(&path, "image 0");
     // And as a data URI.
     let path = dir.join("corrupt-embedded.gltf");
     g.write_gltf_embedded(&path);
-    expect_error(&path, "image 0");
+    expect_texture_problem(&path, "image 0");
 }
 
 #[test]
@@ -296,6 +331,6 @@ fn broken_obj_files() {
         "newmtl m\nKd 1 1 1\nmap_Kd nothere.png\n",
     )
     .unwrap();
-    let err = expect_error(&path, "nothere.png");
+    let err = expect_texture_problem(&path, "nothere.png");
     assert!(err.contains("tex.obj"));
 }

@@ -114,3 +114,93 @@ fn obj_without_mtl_uses_the_default_material() {
     assert_eq!(mesh.positions.len(), 6);
     assert!(mesh.normals.as_ref().unwrap().iter().all(|n| *n == Vec3::Z));
 }
+
+/// Real-world OBJ details (issue 9): texture paths relative to the MTL's folder, one-value
+/// colours, Latin-1 names, empty material names, concave faces, `l` lines, malformed MTL lines.
+#[test]
+fn real_world_obj_details() {
+    let dir = temp_dir("obj-real");
+    std::fs::create_dir_all(dir.join("mats/tex")).unwrap();
+    std::fs::write(dir.join("mats/tex/wood.png"), test_png()).unwrap();
+    std::fs::write(
+        dir.join("mats/lib.mtl"),
+        b"newmtl wood\nKd 0.8\nmap_Kd -s 1 1 1 tex/wood.png\nnewmtl broken\nKd 1 1\nd 0.5\nnewmtl\nKd 0.25 0.5 1\n".as_slice(),
+    )
+    .unwrap();
+    let mut obj = b"mtllib mats/lib.mtl\no caf\xe9\n".to_vec();
+    // An L-shaped (concave) face, starting at a corner where a fan would leave the shape.
+    obj.extend_from_slice(
+        b"v 2 1 0\nv 1 1 0\nv 1 2 0\nv 0 2 0\nv 0 0 0\nv 2 0 0\nvt 0 0\nusemtl wood\nf 1/1 2/1 3/1 4/1 5/1 6/1\n",
+    );
+    obj.extend_from_slice(b"l 1 2 3\nusemtl broken\nf 1 5 6\nusemtl\nf 2 5 6\n");
+    let path = dir.join("real.obj");
+    std::fs::write(&path, &obj).unwrap();
+    let loaded = load_scene(&path).expect("loads");
+    let scene = &loaded.scene;
+    let warnings = loaded.info.warnings.join("\n");
+    // The texture next to the MTL (not next to the OBJ) was found, and Kd 0.8 widened.
+    assert_eq!(scene.textures.len(), 1, "{warnings}");
+    let wood = scene.materials.iter().find(|m| m.name == "wood").unwrap();
+    assert_eq!(wood.base_color_factor.truncate(), glam::Vec3::splat(0.8));
+    assert!(wood.base_color_texture.is_some());
+    // The malformed `Kd 1 1` falls back to the default colour, with a warning.
+    let broken = scene.materials.iter().find(|m| m.name == "broken").unwrap();
+    assert_eq!(broken.base_color_factor.truncate(), glam::Vec3::ONE);
+    assert!(warnings.contains("Kd 1 1"), "{warnings}");
+    // The unnamed material exists and is used.
+    assert!(scene
+        .materials
+        .iter()
+        .any(|m| m.name.is_empty() && m.base_color_factor.x == 0.25));
+    // The Latin-1 object name.
+    assert!(
+        scene.meshes.iter().any(|m| m.name == "café"),
+        "{:?}",
+        scene.meshes.iter().map(|m| &m.name).collect::<Vec<_>>()
+    );
+    // The L face: 4 triangles of total area 3 (a fan from its first corner would cover 3.5 or
+    // leave the shape); the `l` line is not a face.
+    let wood_mesh = scene
+        .meshes
+        .iter()
+        .find(|m| scene.materials[m.material].name == "wood")
+        .unwrap();
+    assert_eq!(wood_mesh.triangle_count(), 4);
+    let area: f32 = wood_mesh
+        .indices
+        .chunks_exact(3)
+        .map(|t| {
+            let p = |i: u32| wood_mesh.positions[i as usize];
+            (p(t[1]) - p(t[0])).cross(p(t[2]) - p(t[0])).z * 0.5
+        })
+        .sum();
+    assert!((area - 3.0).abs() < 1e-5, "area {area}");
+    assert_eq!(scene.triangle_count(), 6);
+    assert!(warnings.contains("line statements"), "{warnings}");
+}
+
+/// A huge polygon is refused by the budget before it is parsed.
+#[test]
+fn huge_obj_polygon_is_refused_by_the_budget() {
+    let dir = temp_dir("obj-huge");
+    let n = 2_000_000;
+    let mut obj = String::with_capacity(n * 16);
+    obj.push_str("v 0 0 0\nv 1 0 0\nv 0 1 0\nf");
+    for i in 0..n {
+        obj.push_str(&format!(" {}", i % 3 + 1));
+    }
+    obj.push('\n');
+    let path = dir.join("huge.obj");
+    std::fs::write(&path, obj).unwrap();
+    let options = kantele_io::LoadOptions {
+        max_memory: 64 << 20,
+        ..kantele_io::LoadOptions::default()
+    };
+    let err = kantele_io::load_scene_with(&path, &options)
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        err.contains("memory budget") && err.contains("huge.obj"),
+        "{err}"
+    );
+}

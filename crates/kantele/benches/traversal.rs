@@ -58,7 +58,7 @@ fn bench_traversal(c: &mut Criterion) {
         for tile in 0..bins.tile_count() {
             for t in bins.tile(tile) {
                 rasterize(
-                    &tris[t as usize],
+                    &tris[t.packed() as usize],
                     grid.tile_rect(tile),
                     Strategy::BoundingBox,
                     |_, _| pixels += 1,
@@ -77,7 +77,7 @@ fn bench_traversal(c: &mut Criterion) {
                         for tile in 0..bins.tile_count() {
                             let rect = grid.tile_rect(tile);
                             for t in bins.tile(tile) {
-                                rasterize(&tris[t as usize], rect, strategy, |x, _| {
+                                rasterize(&tris[t.packed() as usize], rect, strategy, |x, _| {
                                     covered += x as u64 & 1 | 1
                                 });
                             }

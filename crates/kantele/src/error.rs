@@ -53,6 +53,10 @@ pub enum RenderError {
     /// A vertex shader declared more varyings than the pipeline carries.
     #[error("shader declares {0} varyings, at most {max} are supported", max = crate::MAX_VARYINGS)]
     TooManyVaryings(usize),
+    /// The draws of one frame would make more primitive-stage batches than a triangle
+    /// reference can address (about 2^29 triangles; fewer with many small draws).
+    #[error("a frame holds at most {max} triangles in {batches} batches; this draw would exceed it", max = crate::raster::bin::TriangleRef::MAX_BATCHES * 1024, batches = crate::raster::bin::TriangleRef::MAX_BATCHES)]
+    FrameTooLarge,
     /// A scene refers to a mesh, material or texture that does not exist.
     #[error("scene is inconsistent: {0}")]
     InvalidScene(String),

@@ -41,7 +41,8 @@ pub const SUBPIXEL_LIMIT: i64 = 1 << 24;
 /// and values beyond the guard band are clamped; callers reject those triangles earlier.
 #[inline]
 pub fn snap(window: f32) -> i64 {
-    let scaled = (window * SUBPIXEL_ONE as f32).round_ties_even();
+    // `simd::round_ties_even`: `roundss` where the x86-64 baseline would call libm.
+    let scaled = crate::simd::round_ties_even(window * SUBPIXEL_ONE as f32);
     (scaled as i64).clamp(-SUBPIXEL_LIMIT, SUBPIXEL_LIMIT)
 }
 

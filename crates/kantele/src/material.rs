@@ -80,6 +80,8 @@ pub struct MaterialShader<'a> {
     pass: Pass,
     /// `(instance id, draw id)` for the id pass.
     ids: (f32, f32),
+    /// Emissive texture (see [`MaterialShader::with_emissive_texture`]).
+    emissive_texture: Option<(&'a Texture, Sampler)>,
 }
 
 impl<'a> MaterialShader<'a> {
@@ -102,7 +104,15 @@ impl<'a> MaterialShader<'a> {
             texture,
             pass,
             ids: (ids.0 as f32, ids.1 as f32),
+            emissive_texture: None,
         }
+    }
+
+    /// The same shader reading the material's emissive texture (emission: `material.emissive`
+    /// × this texture at the base colour's texture coordinates, added after lighting).
+    pub fn with_emissive_texture(mut self, texture: Option<(&'a Texture, Sampler)>) -> Self {
+        self.emissive_texture = texture;
+        self
     }
 
     /// The fixed-function state the material asks for: culling unless double-sided, and for
@@ -198,7 +208,9 @@ impl Shader for MaterialShader<'_> {
         let l = self.lighting;
         let n_dot_l = self.normal(fragment).dot(l.to_light).max(0.0);
         let light = Vec3::splat(l.ambient) + (1.0 - l.ambient) * n_dot_l * l.light_color;
-        Some((base.truncate() * light).extend(alpha))
+        // --- emissive (loaders work): added after lighting ---
+        let emissive = self.emissive(fragment);
+        Some((base.truncate() * light + emissive).extend(alpha))
     }
 
     #[inline(always)]
@@ -208,6 +220,25 @@ impl Shader for MaterialShader<'_> {
 }
 
 impl MaterialShader<'_> {
+    /// Emitted colour: `material.emissive` × the emissive texture, if any (loaders work).
+    #[inline]
+    fn emissive(&self, fragment: &Fragment<'_>) -> Vec3 {
+        let mut emissive = self.material.emissive;
+        if let Some((texture, sampler)) = self.emissive_texture {
+            let v = fragment.varyings();
+            let (du_dx, du_dy) = fragment.derivatives(3);
+            let (dv_dx, dv_dy) = fragment.derivatives(4);
+            let sample = texture.sample_grad(
+                &sampler,
+                Vec2::new(v[3], v[4]),
+                Vec2::new(du_dx, dv_dx),
+                Vec2::new(du_dy, dv_dy),
+            );
+            emissive *= sample.truncate();
+        }
+        emissive
+    }
+
     /// The value of the normals or ids pass.
     #[inline]
     fn auxiliary(&self, fragment: &Fragment<'_>) -> Vec4 {
@@ -271,15 +302,55 @@ impl MaterialShader<'_> {
             ambient + diffuse * lanes.splat_f32(l.light_color.y),
             ambient + diffuse * lanes.splat_f32(l.light_color.z),
         ];
+        let emissive = self.emissive_lanes(f);
         ShadedLanes {
             color: [
-                base[0] * light[0],
-                base[1] * light[1],
-                base[2] * light[2],
+                base[0] * light[0] + emissive[0],
+                base[1] * light[1] + emissive[1],
+                base[2] * light[2] + emissive[2],
                 alpha,
             ],
             keep,
         }
+    }
+
+    /// [`MaterialShader::emissive`] per lane; the texture is sampled lane by lane.
+    #[inline(always)]
+    fn emissive_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 3] {
+        let lanes = f.lanes;
+        let e = self.material.emissive;
+        let mut emissive = [
+            lanes.splat_f32(e.x),
+            lanes.splat_f32(e.y),
+            lanes.splat_f32(e.z),
+        ];
+        if let Some((texture, sampler)) = self.emissive_texture {
+            let (u, v) = (f.varying(3).to_array(), f.varying(4).to_array());
+            let (du_dx, du_dy) = f.derivatives(3);
+            let (dv_dx, dv_dy) = f.derivatives(4);
+            let (du_dx, du_dy) = (du_dx.to_array(), du_dy.to_array());
+            let (dv_dx, dv_dy) = (dv_dx.to_array(), dv_dy.to_array());
+            let active = f.active.bits();
+            let mut texel = [[0.0f32; 8]; 3];
+            for k in 0..8 {
+                if active & (1 << k) == 0 {
+                    continue;
+                }
+                let t = texture.sample_grad(
+                    &sampler,
+                    Vec2::new(u[k], v[k]),
+                    Vec2::new(du_dx[k], dv_dx[k]),
+                    Vec2::new(du_dy[k], dv_dy[k]),
+                );
+                texel[0][k] = t.x;
+                texel[1][k] = t.y;
+                texel[2][k] = t.z;
+            }
+            for c in 0..3 {
+                emissive[c] = emissive[c] * lanes.f32_from_array(texel[c]);
+            }
+        }
+        emissive
     }
 
     /// `baseColorFactor × COLOR_0 × texture(uv)` per lane; the texture is sampled lane by lane.

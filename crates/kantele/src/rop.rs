@@ -10,7 +10,10 @@ use glam::Vec4;
 pub use crate::state::{BlendMode, DepthFunc};
 
 use crate::error::RenderError;
-use crate::fixed::{TILE_LOG2, TILE_PIXELS, TILE_SIZE};
+use crate::fixed::{BLOCK_LOG2, TILE_LOG2, TILE_PIXELS, TILE_SIZE};
+
+/// 8 × 8 blocks in a tile (64).
+const BLOCKS_PER_TILE: usize = ((TILE_SIZE >> BLOCK_LOG2) * (TILE_SIZE >> BLOCK_LOG2)) as usize;
 use crate::raster::bin::TileGrid;
 use crate::setup::PixelRect;
 
@@ -27,6 +30,9 @@ pub struct TileBuffer {
     depth_bound: f32,
     /// Whether `depth_bound` is the exact maximum (false after writes until recomputed).
     depth_bound_exact: bool,
+    /// The largest depth of each 8 × 8 block (row-major blocks of the tile), kept exact by the
+    /// per-pixel path after every block it writes: the second level of the depth hierarchy.
+    block_depth_max: [f32; BLOCKS_PER_TILE],
 }
 
 /// Margin below a triangle's smallest vertex depth. Interpolated depth is clamped to the
@@ -44,6 +50,7 @@ impl TileBuffer {
             depth: filled_vec(TILE_PIXELS, 1.0)?,
             depth_bound: 1.0,
             depth_bound_exact: true,
+            block_depth_max: [1.0; BLOCKS_PER_TILE],
         })
     }
 
@@ -100,6 +107,29 @@ impl TileBuffer {
         self.depth[index]
     }
 
+    /// Index of the 8 × 8 block holding absolute pixel `(x, y)` within its tile.
+    #[inline(always)]
+    pub fn block_index(x: i32, y: i32) -> usize {
+        let mask = (TILE_SIZE >> BLOCK_LOG2) as i32 - 1;
+        ((((y >> BLOCK_LOG2) & mask) << (TILE_LOG2 - BLOCK_LOG2)) | ((x >> BLOCK_LOG2) & mask))
+            as usize
+    }
+
+    /// Whether a triangle whose vertex depths are at least `min_depth` fails a LESS or LEQUAL
+    /// test on every pixel of block `block` (so the block can be skipped).
+    #[inline(always)]
+    pub fn block_occludes(&self, block: usize, min_depth: f32) -> bool {
+        min_depth - DEPTH_BOUND_SLACK > self.block_depth_max[block]
+    }
+
+    /// Records the exact largest depth of block `block` after the per-pixel path wrote it, and
+    /// keeps the tile's bound valid.
+    #[inline(always)]
+    pub fn set_block_depth_max(&mut self, block: usize, max_depth: f32) {
+        self.block_depth_max[block] = max_depth;
+        self.note_depth_written(max_depth);
+    }
+
     /// Records that depths up to `max_depth` were written, keeping the tile's bound valid.
     #[inline]
     pub fn note_depth_written(&mut self, max_depth: f32) {
@@ -118,6 +148,7 @@ impl TileBuffer {
             self.depth.fill(d);
             self.depth_bound = d;
             self.depth_bound_exact = true;
+            self.block_depth_max = [d; BLOCKS_PER_TILE];
         }
     }
 

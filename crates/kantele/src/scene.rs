@@ -118,6 +118,12 @@ pub struct Material {
     pub alpha_mode: AlphaMode,
     /// `KHR_materials_unlit`: colour = base colour.
     pub unlit: bool,
+    /// Linear emitted colour (`emissiveFactor` × `KHR_materials_emissive_strength`), added after
+    /// lighting (lit materials only).
+    pub emissive: Vec3,
+    /// sRGB emissive texture, multiplied into `emissive`; read with the base colour's
+    /// texture coordinates.
+    pub emissive_texture: Option<TextureBinding>,
 }
 
 impl Default for Material {
@@ -129,6 +135,8 @@ impl Default for Material {
             double_sided: false,
             alpha_mode: AlphaMode::Opaque,
             unlit: false,
+            emissive: Vec3::ZERO,
+            emissive_texture: None,
         }
     }
 }
@@ -295,6 +303,44 @@ impl Scene {
             .sum()
     }
 
+    /// The order in which draws are issued for a camera with world → eye matrix `view`: every
+    /// draw whose material is not `BLEND` first, in scene order, then the `BLEND` draws back to
+    /// front by the eye-space depth of their world bounding-box centre (ties, and draws without
+    /// a finite box, keep scene order). The reference-scene rule; both backends use it per frame.
+    pub fn draw_order(&self, view: &Mat4) -> Vec<usize> {
+        let is_blend = |draw: &Draw| {
+            self.meshes
+                .get(draw.mesh)
+                .and_then(|m| self.materials.get(m.material))
+                .is_some_and(|m| m.alpha_mode == AlphaMode::Blend)
+        };
+        let mut order: Vec<usize> = (0..self.draws.len())
+            .filter(|&i| !is_blend(&self.draws[i]))
+            .collect();
+        let mut blended: Vec<(f32, usize)> = (0..self.draws.len())
+            .filter(|&i| is_blend(&self.draws[i]))
+            .map(|i| {
+                let draw = &self.draws[i];
+                let depth = self
+                    .meshes
+                    .get(draw.mesh)
+                    .and_then(Mesh::bounds)
+                    .map(|(lo, hi)| {
+                        let centre = draw.model.transform_point3((lo + hi) * 0.5);
+                        // Eye space looks down −z: the farthest has the most negative z.
+                        view.transform_point3(centre).z
+                    })
+                    .filter(|z| z.is_finite())
+                    .unwrap_or(f32::NEG_INFINITY);
+                (depth, i)
+            })
+            .collect();
+        // Stable: equal depths keep scene order. Farthest (most negative eye z) first.
+        blended.sort_by(|a, b| a.0.total_cmp(&b.0));
+        order.extend(blended.into_iter().map(|(_, i)| i));
+        order
+    }
+
     /// World-space bounding sphere `(center, radius)` of everything drawn (from the boxes).
     pub fn bounding_sphere(&self) -> Option<(Vec3, f32)> {
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -369,7 +415,10 @@ impl Scene {
             }
         }
         for (i, material) in self.materials.iter().enumerate() {
-            if let Some(binding) = material.base_color_texture {
+            for binding in [material.base_color_texture, material.emissive_texture]
+                .into_iter()
+                .flatten()
+            {
                 if binding.texture >= self.textures.len() {
                     return Err(RenderError::InvalidScene(format!(
                         "material {i} refers to texture {} of {}",
@@ -380,5 +429,56 @@ impl Scene {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Opaque and mask draws keep scene order; blended ones follow, farthest first, ties in
+    /// scene order.
+    #[test]
+    fn draw_order_puts_blend_last_back_to_front() {
+        let mesh = |material| Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            indices: vec![0, 1, 2],
+            material,
+            ..Mesh::default()
+        };
+        let draw = |mesh, z: f32| Draw {
+            mesh,
+            model: Mat4::from_translation(Vec3::new(0.0, 0.0, z)),
+            node_name: String::new(),
+            node_index: 0,
+        };
+        let scene = Scene {
+            meshes: vec![mesh(0), mesh(1), mesh(2)],
+            materials: vec![
+                Material::default(),
+                Material {
+                    alpha_mode: AlphaMode::Blend,
+                    ..Material::default()
+                },
+                Material {
+                    alpha_mode: AlphaMode::Mask { cutoff: 0.5 },
+                    ..Material::default()
+                },
+            ],
+            draws: vec![
+                draw(1, -1.0), // blend, near
+                draw(0, -3.0), // opaque
+                draw(1, -5.0), // blend, far
+                draw(2, -2.0), // mask
+                draw(1, -1.0), // blend, near (tie with draw 0)
+            ],
+            ..Scene::default()
+        };
+        // Camera at the origin looking down −z.
+        assert_eq!(scene.draw_order(&Mat4::IDENTITY), vec![1, 3, 2, 0, 4]);
+        // Seen from the other side (camera at z = −10 looking towards +z) the far one flips.
+        let behind = Mat4::from_rotation_y(std::f32::consts::PI)
+            * Mat4::from_translation(Vec3::new(0.0, 0.0, 10.0));
+        assert_eq!(scene.draw_order(&behind), vec![1, 3, 0, 4, 2]);
     }
 }

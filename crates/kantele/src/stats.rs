@@ -26,6 +26,9 @@ pub struct FrameStats {
     /// Triangle–tile pairs skipped because the triangle lay behind everything already in the
     /// tile (LESS / LEQUAL depth test); their pixels are not counted below.
     pub tiles_depth_rejected: u64,
+    /// Covered 8 × 8 blocks skipped because every depth stored in the block lay in front of the
+    /// triangle (the block level of the depth hierarchy); their pixels are not counted below.
+    pub blocks_depth_rejected: u64,
     /// Pixels covered by triangles (coverage before depth test), outside rejected tiles.
     pub fragments_covered: u64,
     /// Fragments that reached the fragment shader (after the early depth test).

@@ -456,3 +456,48 @@ fn triangles_behind_a_tile_are_skipped_without_changing_the_picture() {
         }
     }
 }
+
+#[test]
+fn blocks_behind_stored_depth_are_skipped_without_changing_the_picture() {
+    // One 64 × 64 tile. A near quad over the left half (x < 32), then a far full-screen quad:
+    // the tile as a whole still has cleared pixels (no tile rejection), but the 32 blocks of the
+    // left half hold only near depths and are skipped; the right half is drawn.
+    let shader = attribute_shader(Mat4::IDENTITY);
+    let v = |x: f32, y: f32, z: f32, c: f32| (Vec3::new(x, y, z), Vec2::splat(c));
+    let near = vec![
+        v(-1.0, -1.0, -0.5, 0.25),
+        v(0.0, -1.0, -0.5, 0.25),
+        v(0.0, 1.0, -0.5, 0.25),
+        v(-1.0, -1.0, -0.5, 0.25),
+        v(0.0, 1.0, -0.5, 0.25),
+        v(-1.0, 1.0, -0.5, 0.25),
+    ];
+    let far = quad(0.5, 0.75);
+    for isa in kantele::simd::Isa::ALL
+        .into_iter()
+        .filter(|i| i.is_supported())
+    {
+        let options = RendererOptions {
+            isa: Some(isa),
+            ..RendererOptions::default()
+        };
+        let mut renderer = Renderer::new(64, 64, options).expect("renderer");
+        let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
+        frame
+            .draw(&shader, &near, Indices::None, no_cull())
+            .expect("draw");
+        frame
+            .draw(&shader, &far, Indices::None, no_cull())
+            .expect("draw");
+        let stats = frame.end();
+        assert_eq!(stats.tiles_depth_rejected, 0, "{isa}");
+        // The far quad's two triangles each cover the 32 left blocks only partly along the
+        // diagonal; every left block covered by a far triangle is rejected.
+        assert!(stats.blocks_depth_rejected >= 32, "{isa}: {stats:?}");
+        let fb = renderer.framebuffer();
+        for (x, y, expected) in [(0, 0, 0.25), (31, 63, 0.25), (32, 0, 0.75), (63, 63, 0.75)] {
+            let got = fb.pixel(x, y).expect("pixel").x;
+            assert!((got - expected).abs() < 1e-5, "{isa} at ({x}, {y}): {got}");
+        }
+    }
+}

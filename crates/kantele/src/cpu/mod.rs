@@ -111,6 +111,11 @@ impl Backend for CpuBackend {
                     view.pass,
                     (draw.node_index as u32 + 1, i as u32 + 1),
                 )
+                .with_emissive_texture(
+                    material
+                        .emissive_texture
+                        .map(|b| (&*scene.textures[b.texture], b.sampler)),
+                )
             })
             .collect();
         let clear = match view.pass {
@@ -118,7 +123,8 @@ impl Backend for CpuBackend {
             Pass::Normals | Pass::Ids => glam::Vec4::ZERO,
         };
         let mut frame = self.renderer.begin_frame(Some(clear), Some(1.0));
-        for (draw, shader) in scene.draws.iter().zip(&shaders) {
+        for index in scene.draw_order(&view.view) {
+            let (draw, shader) = (&scene.draws[index], &shaders[index]);
             let mesh = &meshes[draw.mesh];
             let state = RenderState {
                 front_face: draw.front_face(),

@@ -23,6 +23,7 @@ use crate::simd::{dispatch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct RasterCounters {
     pub(super) tile_rejected: u64,
+    pub(super) blocks_rejected: u64,
     pub(super) covered: u64,
     pub(super) shaded: u64,
     pub(super) discarded: u64,
@@ -32,6 +33,7 @@ impl RasterCounters {
     pub(super) fn sum(a: Self, b: Self) -> Self {
         Self {
             tile_rejected: a.tile_rejected + b.tile_rejected,
+            blocks_rejected: a.blocks_rejected + b.blocks_rejected,
             covered: a.covered + b.covered,
             shaded: a.shaded + b.shaded,
             discarded: a.discarded + b.discarded,
@@ -43,7 +45,7 @@ impl RasterCounters {
 pub(super) fn raster_tiles(
     framebuffer: &mut Framebuffer,
     bins: &TileBins,
-    geometry: &GeometryOutput,
+    geometry: &GeometryOutput<'_>,
     draws: &[Box<dyn DrawJob + '_>],
     strategy: Strategy,
     isa: Isa,
@@ -58,7 +60,7 @@ pub(super) fn raster_tiles(
             let mut counters = RasterCounters::default();
             let mut coverage = BlockCoverage::default();
             for t in bins.tile(tile_index) {
-                let tri = &geometry.triangles[t as usize];
+                let tri = geometry.triangle(t);
                 let draw = &draws[tri.draw as usize];
                 // Early rejection: behind everything already in this tile.
                 if draw.rejects_by_depth_bound() {
@@ -73,7 +75,7 @@ pub(super) fn raster_tiles(
                 if coverage.is_empty() {
                     continue;
                 }
-                let attrs = geometry.attrs_of(t as usize, draws);
+                let attrs = geometry.attrs(t);
                 let c = draw.raster(tri, attrs, &coverage, tile, isa);
                 counters = RasterCounters::sum(counters, c);
             }
@@ -152,9 +154,17 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
             .lane_index()
             .shl::<{ crate::fixed::SUBPIXEL_BITS as i32 }>();
         let mut counters = RasterCounters::default();
-        let mut written_depth_max = f32::NEG_INFINITY;
+        let blocks_can_reject = draw.rejects_by_depth_bound();
 
         for block in coverage.blocks() {
+            // Depth hierarchy, second level: a block whose every stored depth is in front of the
+            // triangle's nearest vertex is skipped (LESS / LEQUAL only; shaders are pure).
+            let block_index = TileBuffer::block_index(block.x, block.y);
+            if blocks_can_reject && tile.block_occludes(block_index, tri.depth_range[0]) {
+                counters.blocks_rejected += 1;
+                continue;
+            }
+            let mut wrote_depth = false;
             for row in 0..8 {
                 let row_bits = (block.mask >> (8 * row)) as u8;
                 if row_bits == 0 {
@@ -224,15 +234,19 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 blended[3].store_masked(keep, a);
                 if state.depth_write {
                     depth.store_masked(keep, tile.depth_row_mut(index));
-                    written_depth_max = written_depth_max.max(
-                        keep.select_f32(depth, lanes.splat_f32(f32::NEG_INFINITY))
-                            .reduce_max(),
-                    );
+                    wrote_depth = true;
                 }
             }
-        }
-        if written_depth_max > f32::NEG_INFINITY {
-            tile.note_depth_written(written_depth_max);
+            if wrote_depth {
+                // Keep the block's bound exact: the largest of its 64 depths.
+                let first = TileBuffer::index(block.x, block.y);
+                let row_stride = crate::fixed::TILE_SIZE as usize;
+                let mut largest = lanes.load_f32(tile.depth_row(first));
+                for row in 1..8 {
+                    largest = largest.max(lanes.load_f32(tile.depth_row(first + row * row_stride)));
+                }
+                tile.set_block_depth_max(block_index, largest.reduce_max());
+            }
         }
         counters
     }

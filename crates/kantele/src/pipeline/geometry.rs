@@ -1,6 +1,8 @@
 //! The geometry stages: the vertex stage (the shader's vertex program on every vertex) and the
 //! primitive stage (assembly, trivial reject, clipping, culling and triangle setup), both parallel
-//! over chunks with their results concatenated in submission order.
+//! over chunks. The primitive stage's batches are handed on as they are, in submission order:
+//! binning and raster address a triangle by its batch and its place in it ([`TriangleRef`]), so
+//! no stage copies the frame's set-up triangles into one array.
 
 use glam::Vec4;
 use rayon::prelude::*;
@@ -34,33 +36,45 @@ impl PrimitiveCounters {
     }
 }
 
-/// The frame's set-up triangles (in draw order) and their varyings.
-#[derive(Default)]
-pub(super) struct GeometryOutput {
-    pub(super) triangles: Vec<TriangleSetup>,
-    /// Varyings of every triangle's three vertices, concatenated in triangle order.
-    pub(super) attrs: Vec<f32>,
-    /// Per draw: index of its first triangle and of its first varying in `attrs`.
-    pub(super) draw_first: Vec<(usize, usize)>,
+/// The frame's set-up triangles and their varyings, as the primitive stage left them: batches in
+/// submission order, each from one draw.
+pub(super) struct GeometryOutput<'g> {
+    batches: &'g [PrimitiveBatch],
 }
 
-impl GeometryOutput {
+impl<'g> GeometryOutput<'g> {
+    /// The batches' triangles, in submission order (what binning reads).
+    pub(super) fn triangle_batches(&self) -> impl Iterator<Item = &'g [TriangleSetup]> + 'g {
+        self.batches.iter().map(|b| b.triangles.as_slice())
+    }
+
+    /// The triangle `r` refers to.
     #[inline]
-    pub(super) fn attrs_of<'s>(
-        &'s self,
-        triangle: usize,
-        draws: &[Box<dyn DrawJob + '_>],
-    ) -> &'s [f32] {
-        let draw = self.triangles[triangle].draw as usize;
-        let n3 = 3 * draws[draw].varying_count();
-        let (first_tri, first_attr) = self.draw_first[draw];
-        let start = first_attr + (triangle - first_tri) * n3;
-        &self.attrs[start..start + n3]
+    pub(super) fn triangle(&self, r: TriangleRef) -> &'g TriangleSetup {
+        &self.batches[r.batch()].triangles[r.index()]
+    }
+
+    /// The varyings of the three (oriented) vertices of triangle `r`, vertex-major.
+    #[inline]
+    pub(super) fn attrs(&self, r: TriangleRef) -> &'g [f32] {
+        let batch = &self.batches[r.batch()];
+        let n3 = 3 * batch.varying_count;
+        let start = r.index() * n3;
+        &batch.attrs[start..start + n3]
     }
 }
 
+pub(super) use crate::raster::bin::TriangleRef;
+
 /// Triangles per unit of parallel work in the primitive stage.
-const PRIMITIVE_CHUNK: usize = 1024;
+pub(super) const PRIMITIVE_CHUNK: usize = 1024;
+
+// Clipping turns a triangle into at most `MAX_CLIPPED_VERTICES − 2` triangles: a batch must fit
+// the index part of a `TriangleRef`.
+const _: () = assert!(
+    PRIMITIVE_CHUNK * (crate::geometry::clip::MAX_CLIPPED_VERTICES - 2)
+        <= TriangleRef::MAX_BATCH_TRIANGLES
+);
 /// Vertices per unit of parallel work in the vertex stage.
 const VERTEX_CHUNK: usize = 2048;
 
@@ -76,13 +90,16 @@ pub(super) struct ShadedVertices {
 pub(super) struct PrimitiveBatch {
     pub(super) triangles: Vec<TriangleSetup>,
     pub(super) attrs: Vec<f32>,
+    /// Varyings per vertex of the batch's draw.
+    pub(super) varying_count: usize,
     pub(super) counters: PrimitiveCounters,
 }
 
 impl PrimitiveBatch {
-    pub(super) fn clear(&mut self) {
+    pub(super) fn clear(&mut self, varying_count: usize) {
         self.triangles.clear();
         self.attrs.clear();
+        self.varying_count = varying_count;
         self.counters = PrimitiveCounters::default();
     }
 }
@@ -99,10 +116,18 @@ pub(super) struct TargetSpace {
 pub(super) struct GeometryScratch {
     /// Vertex-stage output per draw (only the first `draws.len()` are current).
     pub(super) shaded: Vec<ShadedVertices>,
-    /// Primitive-stage output per chunk (only the first `jobs` are current).
+    /// Primitive-stage output per chunk (only the first `current_batches` are current).
     pub(super) batches: Vec<PrimitiveBatch>,
-    /// The frame's triangles and varyings.
-    pub(super) output: GeometryOutput,
+    pub(super) current_batches: usize,
+}
+
+impl GeometryScratch {
+    /// The current frame's set-up triangles.
+    pub(super) fn output(&self) -> GeometryOutput<'_> {
+        GeometryOutput {
+            batches: &self.batches[..self.current_batches],
+        }
+    }
 }
 
 pub(super) fn run_geometry(
@@ -114,7 +139,7 @@ pub(super) fn run_geometry(
     let GeometryScratch {
         shaded,
         batches,
-        output,
+        current_batches,
     } = scratch;
     // 1. Vertex stage over all draws, in chunks.
     if shaded.len() < draws.len() {
@@ -178,7 +203,7 @@ pub(super) fn run_geometry(
         .par_iter_mut()
         .zip(primitive_jobs.par_iter())
         .for_each(|(batch, &(draw, first, last))| {
-            batch.clear();
+            batch.clear(draws[draw].varying_count());
             draws[draw].assemble(
                 draw as u32,
                 first..last,
@@ -189,28 +214,9 @@ pub(super) fn run_geometry(
             );
         });
 
-    output.triangles.clear();
-    output.attrs.clear();
-    output.draw_first.clear();
-    output.draw_first.resize(draws.len(), (0, 0));
-    output
-        .triangles
-        .reserve(batches.iter().map(|b| b.triangles.len()).sum());
-    output
-        .attrs
-        .reserve(batches.iter().map(|b| b.attrs.len()).sum());
+    *current_batches = batches.len();
     let mut counters = PrimitiveCounters::default();
-    let mut next_draw = 0;
     for batch in batches.iter() {
-        if let Some(first) = batch.triangles.first() {
-            // Record where each draw begins (draws with no triangles keep a harmless value).
-            while next_draw <= first.draw as usize {
-                output.draw_first[next_draw] = (output.triangles.len(), output.attrs.len());
-                next_draw += 1;
-            }
-        }
-        output.triangles.extend_from_slice(&batch.triangles);
-        output.attrs.extend_from_slice(&batch.attrs);
         counters = PrimitiveCounters::sum(counters, batch.counters);
     }
     stats.triangles_in = counters.triangles_in;

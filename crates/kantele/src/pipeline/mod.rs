@@ -32,7 +32,7 @@ use crate::error::RenderError;
 use crate::raster::bin::TileBins;
 use crate::raster::Strategy;
 use crate::rop::Framebuffer;
-use crate::setup::Viewport;
+use crate::setup::{TriangleSetup, Viewport};
 use crate::simd::Isa;
 use crate::stats::FrameStats;
 use crate::{MAX_TARGET_SIZE, MAX_VARYINGS};
@@ -133,6 +133,7 @@ impl Renderer {
             clear_color,
             clear_depth,
             draws: Vec::new(),
+            batches: 0,
         }
     }
 }
@@ -160,6 +161,8 @@ pub struct Frame<'r, 'a> {
     clear_color: Option<Vec4>,
     clear_depth: Option<f32>,
     draws: Vec<Box<dyn DrawJob + 'a>>,
+    /// Primitive-stage batches the queued draws will make (bounded by `TriangleRef`).
+    batches: usize,
 }
 
 impl<'a> Frame<'_, 'a> {
@@ -193,6 +196,11 @@ impl<'a> Frame<'_, 'a> {
                 vertex_count: vertices.len(),
             });
         }
+        let batches = self.batches + (count / 3).div_ceil(geometry::PRIMITIVE_CHUNK);
+        if batches > crate::raster::bin::TriangleRef::MAX_BATCHES {
+            return Err(RenderError::FrameTooLarge);
+        }
+        self.batches = batches;
         self.draws.push(Box::new(DrawCall {
             shader,
             vertices,
@@ -209,6 +217,7 @@ impl<'a> Frame<'_, 'a> {
             clear_color,
             clear_depth,
             draws,
+            batches: _,
         } = self;
         let start = Instant::now();
         let mut stats = FrameStats {
@@ -229,20 +238,22 @@ impl<'a> Frame<'_, 'a> {
             let viewport = Viewport::new(framebuffer.width(), framebuffer.height());
             let geometry_start = Instant::now();
             run_geometry(&draws, &viewport, &mut stats, scratch);
-            let geometry = &scratch.output;
+            let geometry = scratch.output();
             stats.geometry_time = geometry_start.elapsed();
 
             let binning_start = Instant::now();
             let grid = *framebuffer.grid();
-            stats.bin_entries = bins.bin_triangles(&grid, &geometry.triangles);
-            stats.triangles_binned = geometry.triangles.len() as u64;
+            let batches: Vec<&[TriangleSetup]> = geometry.triangle_batches().collect();
+            stats.bin_entries = bins.bin_batches(&grid, &batches);
+            stats.triangles_binned = batches.iter().map(|b| b.len() as u64).sum();
             stats.binning_time = binning_start.elapsed();
 
             let raster_start = Instant::now();
             let counters =
-                fragment::raster_tiles(framebuffer, bins, geometry, &draws, strategy, isa);
+                fragment::raster_tiles(framebuffer, bins, &geometry, &draws, strategy, isa);
             stats.fragments_covered = counters.covered;
             stats.tiles_depth_rejected = counters.tile_rejected;
+            stats.blocks_depth_rejected = counters.blocks_rejected;
             stats.fragments_shaded = counters.shaded;
             stats.fragments_discarded = counters.discarded;
             stats.raster_time = raster_start.elapsed();

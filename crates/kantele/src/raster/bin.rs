@@ -50,15 +50,56 @@ impl TileGrid {
     }
 }
 
-/// Per-tile lists of triangle indices, built in parallel: the frame's triangles are split into
+/// A set-up triangle's place in the frame: the primitive-stage batch it is in and its index
+/// there, packed in 32 bits (bins hold millions of them). For triangles given as one slice
+/// ([`TileBins::bin_triangles`]) the reference is simply the triangle's index in the slice.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub struct TriangleRef(u32);
+
+impl TriangleRef {
+    /// Bits of the index within a batch.
+    const INDEX_BITS: u32 = 13;
+    /// Most triangles a batch may hold (8192).
+    pub const MAX_BATCH_TRIANGLES: usize = 1 << Self::INDEX_BITS;
+    /// Most batches a frame may hold (2^19).
+    pub const MAX_BATCHES: usize = 1 << (32 - Self::INDEX_BITS);
+
+    /// The reference to triangle `index` of batch `batch` (`index <
+    /// MAX_BATCH_TRIANGLES`, `batch < MAX_BATCHES`).
+    #[inline]
+    pub fn new(batch: usize, index: usize) -> Self {
+        debug_assert!(index < Self::MAX_BATCH_TRIANGLES && batch < Self::MAX_BATCHES);
+        Self(((batch as u32) << Self::INDEX_BITS) | index as u32)
+    }
+
+    /// The batch.
+    #[inline]
+    pub fn batch(self) -> usize {
+        (self.0 >> Self::INDEX_BITS) as usize
+    }
+
+    /// The index within the batch.
+    #[inline]
+    pub fn index(self) -> usize {
+        (self.0 & ((1 << Self::INDEX_BITS) - 1)) as usize
+    }
+
+    /// The packed value (for one-slice binning: the triangle's index).
+    #[inline]
+    pub fn packed(self) -> u32 {
+        self.0
+    }
+}
+
+/// Per-tile lists of triangle references, built in parallel: the frame's batches are split into
 /// consecutive chunks, each chunk is binned by one thread into lists of its own, and a tile's
 /// triangles are its lists read chunk after chunk — submission order, whatever the thread count,
 /// with no merge copy. Lists keep their allocations from frame to frame.
 #[derive(Clone, Debug, Default)]
 pub struct TileBins {
-    /// `chunks[c][tile]`: indices of chunk `c`'s triangles touching `tile`, in order (only the
-    /// first `chunk_count` chunks are current).
-    chunks: Vec<Vec<Vec<u32>>>,
+    /// `chunks[c][tile]`: chunk `c`'s triangles touching `tile`, in order (only the first
+    /// `chunk_count` chunks are current).
+    chunks: Vec<Vec<Vec<TriangleRef>>>,
     chunk_count: usize,
     tile_count: usize,
 }
@@ -67,18 +108,41 @@ pub struct TileBins {
 const MIN_TRIANGLES_PER_CHUNK: usize = 4096;
 
 impl TileBins {
-    /// Appends every triangle to the bins its bounding box touches; returns the number of bin
-    /// entries written. A triangle whose box touches a tile but covers none of its pixels is
-    /// still binned there; traversal finds no pixel.
+    /// Bins one slice of triangles (references are their indices in the slice); returns the
+    /// number of bin entries written. See [`TileBins::bin_batches`].
     pub fn bin_triangles(&mut self, grid: &TileGrid, triangles: &[TriangleSetup]) -> u64 {
+        let batches: Vec<&[TriangleSetup]> =
+            triangles.chunks(TriangleRef::MAX_BATCH_TRIANGLES).collect();
+        self.bin_batches(grid, &batches)
+    }
+
+    /// Appends every triangle of `batches` (in order) to the bins its bounding box touches;
+    /// returns the number of bin entries written. A triangle whose box touches a tile but covers
+    /// none of its pixels is still binned there; traversal finds no pixel. Each batch holds at
+    /// most [`TriangleRef::MAX_BATCH_TRIANGLES`] triangles, and there are at most
+    /// [`TriangleRef::MAX_BATCHES`] batches.
+    pub fn bin_batches(&mut self, grid: &TileGrid, batches: &[&[TriangleSetup]]) -> u64 {
         use rayon::prelude::*;
         let tile_count = grid.tile_count();
+        let total: usize = batches.iter().map(|b| b.len()).sum();
         let wanted = (2 * rayon::current_num_threads()).max(1);
-        let chunk_count = triangles
-            .len()
+        let chunk_count = total
             .div_ceil(MIN_TRIANGLES_PER_CHUNK)
-            .clamp(1, wanted);
-        let per_chunk = triangles.len().div_ceil(chunk_count).max(1);
+            .clamp(1, wanted)
+            .min(batches.len().max(1));
+        // Consecutive runs of batches with about `total / chunk_count` triangles each.
+        let mut bounds = Vec::with_capacity(chunk_count + 1);
+        bounds.push(0);
+        let mut seen = 0;
+        for (i, b) in batches.iter().enumerate() {
+            seen += b.len();
+            if bounds.len() < chunk_count && seen * chunk_count >= bounds.len() * total {
+                bounds.push(i + 1);
+            }
+        }
+        while bounds.len() <= chunk_count {
+            bounds.push(batches.len());
+        }
         if self.chunks.len() < chunk_count {
             self.chunks.resize_with(chunk_count, Vec::new);
         }
@@ -93,16 +157,16 @@ impl TileBins {
                 for bin in bins.iter_mut() {
                     bin.clear();
                 }
-                let first = (c * per_chunk).min(triangles.len());
-                let last = ((c + 1) * per_chunk).min(triangles.len());
-                bin_range(grid, triangles, first..last, bins)
+                (bounds[c]..bounds[c + 1])
+                    .map(|b| bin_batch(grid, b, batches[b], bins))
+                    .sum::<u64>()
             })
             .sum()
     }
 
     /// The triangles touching `tile`, in submission order.
     #[inline]
-    pub fn tile(&self, tile: usize) -> impl Iterator<Item = u32> + '_ {
+    pub fn tile(&self, tile: usize) -> impl Iterator<Item = TriangleRef> + '_ {
         self.chunks[..self.chunk_count]
             .iter()
             .flat_map(move |bins| bins[tile].iter().copied())
@@ -114,24 +178,25 @@ impl TileBins {
     }
 }
 
-/// Bins triangles `range` (indices into `triangles`) into `bins` (one list per tile).
-fn bin_range(
+/// Bins the triangles of batch `batch` into `bins` (one list per tile).
+fn bin_batch(
     grid: &TileGrid,
+    batch: usize,
     triangles: &[TriangleSetup],
-    range: std::ops::Range<usize>,
-    bins: &mut [Vec<u32>],
+    bins: &mut [Vec<TriangleRef>],
 ) -> u64 {
     let mut entries = 0u64;
-    for index in range {
-        let b = triangles[index].bbox;
+    for (index, tri) in triangles.iter().enumerate() {
+        let b = tri.bbox;
         let tx0 = (b.x0 >> TILE_LOG2) as usize;
         let tx1 = ((b.x1 - 1) >> TILE_LOG2) as usize;
         let ty0 = (b.y0 >> TILE_LOG2) as usize;
         let ty1 = ((b.y1 - 1) >> TILE_LOG2) as usize;
+        let r = TriangleRef::new(batch, index);
         for ty in ty0..=ty1 {
             let row = ty * grid.tiles_x as usize;
             for bin in &mut bins[row + tx0..=row + tx1] {
-                bin.push(index as u32);
+                bin.push(r);
             }
         }
         entries += ((tx1 - tx0 + 1) * (ty1 - ty0 + 1)) as u64;
@@ -170,7 +235,7 @@ mod tests {
         let mut bins = TileBins::default();
         let entries = bins.bin_triangles(&grid, &[a, b]);
         assert_eq!(entries, 2 + 16);
-        let tile = |t: usize| bins.tile(t).collect::<Vec<_>>();
+        let tile = |t: usize| bins.tile(t).map(|r| r.packed()).collect::<Vec<_>>();
         assert_eq!(tile(0), vec![0, 1]);
         assert_eq!(tile(1), vec![0, 1]);
         assert_eq!(tile(2), vec![1]);
@@ -207,10 +272,10 @@ mod tests {
                 .unwrap();
             let mut bins = TileBins::default();
             pool.install(|| bins.bin_triangles(&grid, &triangles));
-            let tile0: Vec<u32> = bins.tile(0).collect();
+            let tile0: Vec<u32> = bins.tile(0).map(|r| r.packed()).collect();
             let expected: Vec<u32> = (0..20_000).step_by(2).collect();
             assert_eq!(tile0, expected, "{threads} threads");
-            let tile5: Vec<u32> = bins.tile(5).collect();
+            let tile5: Vec<u32> = bins.tile(5).map(|r| r.packed()).collect();
             assert_eq!(tile5, (1..20_000).step_by(2).collect::<Vec<u32>>());
         }
     }

@@ -241,19 +241,25 @@ impl TileMasks {
         self.masks[block as usize] |= 1u64 << (((y & 7) << 3) | (x & 7));
     }
 
-    /// Appends the non-empty blocks of the tile holding `rect`.
+    /// Appends the non-empty blocks of `rect` (which lies in one tile).
     fn emit(&self, rect: PixelRect, out: &mut BlockCoverage) {
         let (tx, ty) = (
             rect.x0 & !(TILE_SIZE as i32 - 1),
             rect.y0 & !(TILE_SIZE as i32 - 1),
         );
-        for (i, &mask) in self.masks.iter().enumerate() {
-            let i = i as i32;
-            out.push(
-                tx + ((i & 7) << BLOCK_LOG2),
-                ty + ((i >> 3) << BLOCK_LOG2),
-                mask,
-            );
+        let (bx0, bx1) = (
+            (rect.x0 - tx) >> BLOCK_LOG2,
+            ((rect.x1 - 1 - tx) >> BLOCK_LOG2) + 1,
+        );
+        let (by0, by1) = (
+            (rect.y0 - ty) >> BLOCK_LOG2,
+            ((rect.y1 - 1 - ty) >> BLOCK_LOG2) + 1,
+        );
+        for by in by0..by1 {
+            for bx in bx0..bx1 {
+                let mask = self.masks[(by * 8 + bx) as usize];
+                out.push(tx + (bx << BLOCK_LOG2), ty + (by << BLOCK_LOG2), mask);
+            }
         }
     }
 }

@@ -1,0 +1,139 @@
+//! Triangulating polygons (OBJ faces with more than three corners) by ear clipping, so that
+//! concave faces keep their shape (a fan would cover area outside them).
+
+use glam::{Vec2, Vec3};
+
+/// Polygons with more corners than this are fan-split instead (ear clipping is quadratic).
+pub(crate) const MAX_EAR_CLIP_CORNERS: usize = 4096;
+
+/// Triangles (as corner numbers `0..n`, counter-clockwise like the polygon) covering the
+/// polygon with the given corner positions; `None` when it is too large or degenerate for ear
+/// clipping (the caller falls back to a fan).
+pub(crate) fn triangulate(corners: &[Vec3]) -> Option<Vec<[usize; 3]>> {
+    let n = corners.len();
+    if !(3..=MAX_EAR_CLIP_CORNERS).contains(&n) || corners.iter().any(|c| !c.is_finite()) {
+        return None;
+    }
+    if n == 3 {
+        return Some(vec![[0, 1, 2]]);
+    }
+    // Project onto the plane of the polygon's Newell normal.
+    let mut normal = Vec3::ZERO;
+    for i in 0..n {
+        let (a, b) = (corners[i], corners[(i + 1) % n]);
+        normal += Vec3::new(
+            (a.y - b.y) * (a.z + b.z),
+            (a.z - b.z) * (a.x + b.x),
+            (a.x - b.x) * (a.y + b.y),
+        );
+    }
+    let normal = normal.try_normalize()?;
+    let u = normal.any_orthonormal_vector();
+    let v = normal.cross(u);
+    let p: Vec<Vec2> = corners
+        .iter()
+        .map(|c| Vec2::new(c.dot(u), c.dot(v)))
+        .collect();
+    // With this basis the polygon is counter-clockwise in (u, v).
+    let cross = |a: Vec2, b: Vec2, c: Vec2| (b - a).perp_dot(c - a);
+    let mut remaining: Vec<usize> = (0..n).collect();
+    let mut triangles = Vec::with_capacity(n - 2);
+    let mut guard = 0;
+    while remaining.len() > 3 {
+        let m = remaining.len();
+        let mut clipped = false;
+        for i in 0..m {
+            let (ia, ib, ic) = (
+                remaining[(i + m - 1) % m],
+                remaining[i],
+                remaining[(i + 1) % m],
+            );
+            let (a, b, c) = (p[ia], p[ib], p[ic]);
+            if cross(a, b, c) <= 0.0 {
+                continue; // reflex or flat corner
+            }
+            let inside = remaining.iter().any(|&j| {
+                if j == ia || j == ib || j == ic {
+                    return false;
+                }
+                let q = p[j];
+                cross(a, b, q) >= 0.0 && cross(b, c, q) >= 0.0 && cross(c, a, q) >= 0.0
+            });
+            if !inside {
+                triangles.push([ia, ib, ic]);
+                remaining.remove(i);
+                clipped = true;
+                break;
+            }
+        }
+        if !clipped {
+            guard += 1;
+            if guard > 1 {
+                return None; // self-intersecting or degenerate: no ear left
+            }
+            // Drop a flat corner (collinear neighbours) and try again.
+            let m = remaining.len();
+            let flat = (0..m).find(|&i| {
+                let (a, b, c) = (
+                    p[remaining[(i + m - 1) % m]],
+                    p[remaining[i]],
+                    p[remaining[(i + 1) % m]],
+                );
+                cross(a, b, c).abs() <= f32::EPSILON * (b - a).length() * (c - b).length()
+            })?;
+            remaining.remove(flat);
+        } else {
+            guard = 0;
+        }
+    }
+    triangles.push([remaining[0], remaining[1], remaining[2]]);
+    Some(triangles)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn area(corners: &[Vec3], tris: &[[usize; 3]]) -> f32 {
+        tris.iter()
+            .map(|t| {
+                (corners[t[1]] - corners[t[0]])
+                    .cross(corners[t[2]] - corners[t[0]])
+                    .z
+                    * 0.5
+            })
+            .sum()
+    }
+
+    #[test]
+    fn concave_polygon_keeps_its_area_and_winding() {
+        // An L shape (area 3), counter-clockwise, starting at the reflex-adjacent corner so that
+        // a fan from corner 0 would cover area outside it.
+        let l = [
+            Vec3::new(1.0, 1.0, 0.0),
+            Vec3::new(1.0, 2.0, 0.0),
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(2.0, 1.0, 0.0),
+        ];
+        let tris = triangulate(&l).unwrap();
+        assert_eq!(tris.len(), 4);
+        assert!((area(&l, &tris) - 3.0).abs() < 1e-5);
+        // Every triangle is counter-clockwise (positive area).
+        assert!(tris.iter().all(|t| area(&l, &[*t]) > 0.0));
+    }
+
+    #[test]
+    fn clockwise_polygons_stay_clockwise() {
+        let sq = [Vec3::ZERO, Vec3::Y, Vec3::new(1.0, 1.0, 0.0), Vec3::X];
+        let tris = triangulate(&sq).unwrap();
+        assert!((area(&sq, &tris) + 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn degenerate_polygons_fall_back() {
+        assert!(triangulate(&[Vec3::ZERO; 5]).is_none());
+        assert!(triangulate(&[Vec3::ZERO, Vec3::X]).is_none());
+    }
+}
