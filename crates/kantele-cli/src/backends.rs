@@ -19,10 +19,18 @@ pub fn make_backend(kind: BackendKind, cpu: &CpuArgs, fast: bool) -> Result<Box<
             let backend = CpuBackend::new(options).map_err(|e| anyhow!("cpu backend: {e}"))?;
             Ok(Box::new(backend))
         }
+        #[cfg(feature = "gl")]
         BackendKind::Gl => {
             let mut backend = kantele_gl::GlBackend::new().map_err(|e| anyhow!("{e}"))?;
             backend.set_fast_target(fast);
             Ok(Box::new(backend))
+        }
+        #[cfg(not(feature = "gl"))]
+        BackendKind::Gl => {
+            let _ = fast;
+            Err(anyhow!(
+                "gl backend: this kantele was built without it (cargo install --locked --path crates/kantele-cli --features gl)"
+            ))
         }
         BackendKind::Cuda | BackendKind::CudaOcot | BackendKind::CudaOcmt => {
             cuda_backend(kind, fast)

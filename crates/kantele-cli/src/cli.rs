@@ -31,12 +31,28 @@ pub enum Command {
     Compare(CompareArgs),
     /// Open a window and look at a scene with an orbit camera (CPU backend).
     View(ViewArgs),
+    /// Write a square PNG thumbnail of a scene: framed, transparent background.
+    Thumbnail(ThumbnailArgs),
+}
+
+/// `kantele thumbnail IN OUT --size N`.
+#[derive(Debug, Args)]
+pub struct ThumbnailArgs {
+    /// The scene file.
+    #[arg(value_name = "IN")]
+    pub input: PathBuf,
+    /// The PNG to write.
+    #[arg(value_name = "OUT")]
+    pub output: PathBuf,
+    /// Width and height in pixels.
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    pub size: u32,
 }
 
 /// Which scenes to work on: files and built-in scenes.
 #[derive(Debug, Args, Clone)]
 pub struct SceneArgs {
-    /// Scene files (.gltf, .glb, .obj).
+    /// Scene files (.gltf, .glb, .obj), folders of them, or quoted patterns ("scans/*.glb").
     #[arg(value_name = "SCENE")]
     pub scenes: Vec<PathBuf>,
     /// A built-in scene (cube, teapot, ground, pixel-edges); may be repeated. Built-ins come after the files.
@@ -103,11 +119,42 @@ impl BackendKind {
 /// What `--depth` stores.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
 pub enum DepthKind {
-    /// Linear eye-space distance along the view axis (−z_eye), background +inf.
+    /// Planar depth: distance along the view axis (−z_eye), background +inf (0 in PNG).
     #[default]
     Eye,
+    /// Ray distance: from the camera centre to the surface point, background +inf (0 in PNG).
+    Ray,
     /// Raw window depth in [0, 1], background 1.0.
     Window,
+}
+
+/// Unit of `--depth` values (eye and ray depth).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum DepthUnit {
+    /// Scene units (metres in glTF).
+    M,
+    /// Millimetres: scene units × 1000 (the BOP convention for 16-bit PNG depth).
+    Mm,
+}
+
+/// The frame `--normals` are expressed in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum NormalSpace {
+    /// World space.
+    #[default]
+    World,
+    /// Camera space, OpenCV axes (x right, y down, z forward).
+    Camera,
+}
+
+/// The up axis of automatic framing and orbits.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, ValueEnum)]
+pub enum UpArg {
+    /// +Y up (glTF).
+    #[default]
+    Y,
+    /// +Z up (many scans and CAD files).
+    Z,
 }
 
 /// Options of the CPU backend shared by several commands.
@@ -128,61 +175,176 @@ pub struct RenderArgs {
     /// Scenes to render.
     #[command(flatten)]
     pub input: SceneArgs,
-    /// Colour output (.png: 8-bit sRGB RGBA; .exr: linear float RGBA). With several scenes or
-    /// --orbit this is a template: {stem}, {index}, {frame}. A JSON sidecar OUT.json is written
-    /// next to each colour image.
+    /// Colour output (.png: 8-bit sRGB RGBA; .exr: linear float RGBA; .npy: float32 (H, W, 4);
+    /// .gif/.apng: every view as one animation; `-` writes the PNG to standard output). With several scenes or views this is a template: {stem}, {index},
+    /// {frame}. A JSON sidecar OUT.json is written next to each colour image (not for `-`).
     #[arg(short, long, value_name = "OUT")]
     pub output: String,
     /// Image size WxH, overriding the scene's resolution (each side 1..=16384).
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Depth output (.pfm or .exr, 32-bit float); same template rules as -o.
-    #[arg(long, value_name = "OUT")]
-    pub depth: Option<String>,
-    /// What the depth image stores.
-    #[arg(long, value_enum, default_value_t = DepthKind::Eye)]
-    pub depth_kind: DepthKind,
-    /// World-normal output: .png (n*0.5+0.5, 8-bit linear, background transparent black) or .exr
-    /// (float normals, background 0).
-    #[arg(long, value_name = "OUT")]
-    pub normals: Option<String>,
-    /// Id output: .png (16-bit RGB: R = instance id, G = primitive id, B = draw id) or .exr
-    /// (float RGB holding the same exact integers). 0 = background.
-    #[arg(long, value_name = "OUT")]
-    pub ids: Option<String>,
     /// Backend to render with.
     #[arg(long, value_enum, default_value_t = BackendKind::Cpu)]
     pub backend: BackendKind,
     /// CPU backend options.
     #[command(flatten)]
     pub cpu: CpuArgs,
-    /// Render N views on a circle around the scene's bounding sphere (20° elevation) instead
-    /// of the scene's camera; written as numbered images ({frame}).
-    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100000))]
-    pub orbit: Option<u32>,
     /// Print one JSON line per finished image on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Frames per second of an animated -o (.gif, .apng).
+    #[arg(long, value_name = "N", default_value_t = 24, value_parser = clap::value_parser!(u16).range(1..=100))]
+    pub fps: u16,
+    /// Skip images whose files all exist already (resume an interrupted batch).
+    #[arg(long)]
+    pub skip_existing: bool,
+    /// Cameras and background.
+    #[command(flatten)]
+    pub camera: CameraArgs,
+    /// Depth, normal and id outputs.
+    #[command(flatten)]
+    pub extra: ExtraOutputArgs,
 }
 
-const RENDER_HELP: &str = "\
-Output templates:
+/// Which cameras `render` uses, and the background.
+#[derive(Debug, Args, Clone, Default)]
+pub struct CameraArgs {
+    /// The camera: `N` or `NAME` (a camera of the file), `auto` (frame the bounding box,
+    /// ignoring the file's cameras) or `look-at:EYE:TARGET[:UP]` (comma-separated x,y,z).
+    /// Default: the file's first camera, else `auto`.
+    #[arg(long, value_name = "SPEC", conflicts_with_all = ["views", "orbit"])]
+    pub camera: Option<String>,
+    /// Vertical field of view in degrees of `auto`, `look-at` and orbit cameras (default 45).
+    #[arg(long, value_name = "DEG", value_parser = parse_fov)]
+    pub fov: Option<f32>,
+    /// Render the views of a file: a sidecar written by `render` (reproduces its picture) or a
+    /// list of poses (see --help).
+    #[arg(long, value_name = "FILE", conflicts_with = "orbit")]
+    pub views: Option<PathBuf>,
+    /// Render N views on a circle around the scene's bounding box, written as numbered images
+    /// ({frame}), or as one animated image when -o is .gif or .apng.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100000))]
+    pub orbit: Option<u32>,
+    /// Orbit elevation above the horizon, degrees.
+    #[arg(
+        long,
+        value_name = "DEG",
+        default_value_t = 20.0,
+        allow_negative_numbers = true,
+        requires = "orbit"
+    )]
+    pub elevation: f32,
+    /// Orbit radius in scene units (default: the bounding sphere fills the picture).
+    #[arg(long, value_name = "R", requires = "orbit")]
+    pub radius: Option<f32>,
+    /// Up axis of `auto` framing and orbits.
+    #[arg(long, value_enum, default_value_t = UpArg::Y)]
+    pub up: UpArg,
+    /// Background: a name (black, white, grey, ...), #rrggbb[aa], r,g,b[,a] in 0..=1 or 0..=255,
+    /// or `transparent`. Default: the scene's clear colour.
+    #[arg(long, value_name = "COLOR", value_parser = parse_color)]
+    pub background: Option<[f32; 4]>,
+}
+
+/// Depth, normal and id outputs of `render` (file names follow the -o template rules).
+#[derive(Debug, Args, Clone, Default)]
+pub struct ExtraOutputArgs {
+    /// Depth output: .png (16-bit gray, 0 = background, millimetres unless --depth-unit m),
+    /// .exr (one float channel), .pfm or .npy (float32).
+    #[arg(long, value_name = "OUT")]
+    pub depth: Option<String>,
+    /// What the depth image stores.
+    #[arg(long, value_enum, default_value_t = DepthKind::Eye)]
+    pub depth_kind: DepthKind,
+    /// Unit of eye and ray depth (default: mm for .png, m otherwise).
+    #[arg(long, value_enum)]
+    pub depth_unit: Option<DepthUnit>,
+    /// Normal output: .png (n*0.5+0.5, 8-bit, background transparent black), .exr (float RGB,
+    /// background 0) or .npy (float32 HxWx3, background 0).
+    #[arg(long, value_name = "OUT")]
+    pub normals: Option<String>,
+    /// The frame normals are expressed in.
+    #[arg(long, value_enum, default_value_t = NormalSpace::World)]
+    pub normals_space: NormalSpace,
+    /// Id output KIND=FILE (repeatable; a bare FILE means instance=FILE). KIND: instance, mesh,
+    /// material, primitive (a mesh primitive placed by a node: one draw), triangle (within its
+    /// draw). One channel, 0 = background: .png (16-bit gray), .exr (u32) or .npy (uint32).
+    #[arg(long = "ids", value_name = "KIND=FILE", value_parser = parse_ids)]
+    pub ids: Vec<(IdKind, String)>,
+}
+
+/// What an id image holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum IdKind {
+    /// The node: node index + 1.
+    Instance,
+    /// The scene mesh: mesh index + 1.
+    Mesh,
+    /// The material: material index + 1.
+    Material,
+    /// The draw (a mesh primitive placed by a node): draw index + 1.
+    Primitive,
+    /// The triangle within its draw: triangle index + 1.
+    Triangle,
+}
+
+impl IdKind {
+    /// Every kind, in the order of the names.
+    pub const ALL: [IdKind; 5] = [
+        IdKind::Instance,
+        IdKind::Mesh,
+        IdKind::Material,
+        IdKind::Primitive,
+        IdKind::Triangle,
+    ];
+
+    /// The name used on the command line and in the sidecar.
+    pub fn name(self) -> &'static str {
+        match self {
+            IdKind::Instance => "instance",
+            IdKind::Mesh => "mesh",
+            IdKind::Material => "material",
+            IdKind::Primitive => "primitive",
+            IdKind::Triangle => "triangle",
+        }
+    }
+}
+
+const RENDER_HELP: &str = r#"Output templates:
   {stem}   file stem of the scene (or the built-in's name)
   {index}  number of the image among all images written by this command (0000, 0001, ...)
   {frame}  number of the orbit view (0000 without --orbit)
   Several scenes or --orbit N>1 need placeholders that make every name unique.
 
-Depth (--depth): 32-bit float, one value per pixel.
-  .pfm: greyscale 'Pf', little-endian, rows bottom to top (as PFM requires).
-  .exr: RGB float with the value in all three channels.
+Cameras:
+  --camera look-at:0,1,5:0,0,0[:0,1,0]   eye, target and up as x,y,z
+  --views FILE   a sidecar (OUT.json) or {"views": [{"world_to_camera": 4x4 rows,
+                 "convention": "opencv"|"opengl", "fx","fy","cx","cy" or "yfov",
+                 "width","height"}, ...]}; one image per view ({frame}).
+  Pixels stay square: the image's aspect decides the field of view across; without --size the
+  image takes the file camera's aspect ratio.
+
+Depth (--depth), one value per pixel:
+  .pfm: greyscale 'Pf' float, little-endian, rows bottom to top (as PFM requires).
+  .exr: one float channel 'Y'.   .npy: float32, shape (H, W).
+  .png: 16-bit gray, round(depth) in --depth-unit (mm by default), 0 = background (BOP).
   eye:    distance along the view axis (-z in eye space), background +inf.
+  ray:    distance from the camera centre, background +inf.
   window: window depth in [0, 1] as the depth buffer holds it, background 1.0.
+
+Ids (--ids KIND=FILE): one channel per file, 0 = background; PNG when every id of the scene
+fits 16 bits, else .exr (u32) or .npy (uint32). The sidecar maps ids to nodes and meshes.
+
+Output sets: every file of an image (colour, depth, normals, ids, sidecar last) is written to
+temporaries and moved into place together; Ctrl-C (SIGINT/SIGTERM) drops the image in flight,
+removes its temporaries and exits with status 130. Outputs that would overwrite a scene file,
+its textures or each other are refused before rendering; output folders are created first.
 
 Sidecar OUT.json: camera intrinsics (fx, fy, cx, cy in pixels with pixel centres at integer
 coordinates as in OpenCV; width, height, yfov, znear, zfar = null for an infinite projection),
 world-to-camera matrices (rows) in OpenGL convention (x right, y up, looking down -z) and
 OpenCV convention (x right, y down, z forward), the depth convention, id maps, scene source,
-backend, renderer and render time.";
+backend, renderer and render time."#;
 
 /// `kantele info`.
 #[derive(Debug, Args)]
@@ -310,12 +472,11 @@ pub struct ViewArgs {
     /// Initial window size WxH.
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
-    /// Quit after N frames (for tests).
     /// Spin the camera around the scene at this many degrees per second (the blog's spinning
     /// teapot); dragging still works.
     #[arg(long, value_name = "DEG_PER_S")]
     pub spin: Option<f32>,
-
+    /// Quit after N frames (for tests).
     #[arg(long, hide = true)]
     pub frames: Option<u64>,
     /// Save the last frame as PNG when quitting (for tests).
@@ -351,6 +512,116 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
         ));
     }
     Ok((w as u32, h as u32))
+}
+
+/// Parses a vertical field of view in degrees, in (0, 180).
+pub fn parse_fov(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
+        _ => Err(format!("field of view '{s}' must be degrees in (0, 180)")),
+    }
+}
+
+/// Parses `KIND=FILE` (or a bare `FILE`, meaning `instance=FILE`).
+pub fn parse_ids(s: &str) -> Result<(IdKind, String), String> {
+    if let Some((kind, file)) = s.split_once('=') {
+        if let Some(k) = IdKind::ALL.iter().find(|k| k.name() == kind) {
+            if file.is_empty() {
+                return Err(format!("--ids {s}: no file after '='"));
+            }
+            return Ok((*k, file.to_string()));
+        }
+        if !kind.contains(['/', '.', '\\']) {
+            return Err(format!(
+                "--ids {s}: unknown id kind '{kind}' (use instance, mesh, material, primitive or triangle)"
+            ));
+        }
+    }
+    if s.is_empty() {
+        return Err("--ids needs KIND=FILE".into());
+    }
+    Ok((IdKind::Instance, s.to_string()))
+}
+
+/// Parses a colour: a name, `#rgb`/`#rrggbb`/`#rrggbbaa`, `r,g,b[,a]` (all in 0..=1, or
+/// integers up to 255), or `transparent`. The result is linear RGBA (names, hex and 0..=255
+/// values are sRGB and are decoded).
+pub fn parse_color(s: &str) -> Result<[f32; 4], String> {
+    let bad = || {
+        format!(
+            "colour '{s}' is not a name (black, white, grey, red, ...), #rrggbb[aa], r,g,b[,a] or transparent"
+        )
+    };
+    let t = s.trim().to_ascii_lowercase();
+    let srgb8 = |c: [u8; 4]| {
+        [
+            kantele::color::srgb_to_linear(c[0] as f32 / 255.0),
+            kantele::color::srgb_to_linear(c[1] as f32 / 255.0),
+            kantele::color::srgb_to_linear(c[2] as f32 / 255.0),
+            c[3] as f32 / 255.0,
+        ]
+    };
+    let named: Option<[u8; 4]> = match t.as_str() {
+        "transparent" | "none" => return Ok([0.0; 4]),
+        "black" => Some([0, 0, 0, 255]),
+        "white" => Some([255, 255, 255, 255]),
+        "grey" | "gray" => Some([128, 128, 128, 255]),
+        "red" => Some([255, 0, 0, 255]),
+        "green" => Some([0, 255, 0, 255]),
+        "blue" => Some([0, 0, 255, 255]),
+        _ => None,
+    };
+    if let Some(c) = named {
+        return Ok(srgb8(c));
+    }
+    if let Some(hex) = t.strip_prefix('#') {
+        let digits: Vec<u8> = hex
+            .chars()
+            .map(|c| c.to_digit(16).map(|d| d as u8))
+            .collect::<Option<_>>()
+            .ok_or_else(bad)?;
+        let c = match digits.len() {
+            3 => [digits[0] * 17, digits[1] * 17, digits[2] * 17, 255],
+            6 | 8 => {
+                let byte = |i: usize| digits[2 * i] * 16 + digits[2 * i + 1];
+                [
+                    byte(0),
+                    byte(1),
+                    byte(2),
+                    if digits.len() == 8 { byte(3) } else { 255 },
+                ]
+            }
+            _ => return Err(bad()),
+        };
+        return Ok(srgb8(c));
+    }
+    let parts: Vec<f32> = t
+        .split(',')
+        .map(|p| {
+            p.trim()
+                .parse::<f32>()
+                .ok()
+                .filter(|v| v.is_finite() && *v >= 0.0)
+        })
+        .collect::<Option<_>>()
+        .ok_or_else(bad)?;
+    if parts.len() != 3 && parts.len() != 4 {
+        return Err(bad());
+    }
+    if parts.iter().all(|v| *v <= 1.0) {
+        let a = parts.get(3).copied().unwrap_or(1.0);
+        return Ok([parts[0], parts[1], parts[2], a]);
+    }
+    if parts.iter().all(|v| *v <= 255.0 && v.fract() == 0.0) {
+        let a = parts.get(3).copied().unwrap_or(255.0);
+        return Ok(srgb8([
+            parts[0] as u8,
+            parts[1] as u8,
+            parts[2] as u8,
+            a as u8,
+        ]));
+    }
+    Err(bad())
 }
 
 fn parse_strategy(s: &str) -> Result<Strategy, String> {

@@ -44,7 +44,7 @@ pub fn run(args: &CompareArgs) -> Result<bool> {
     }
     let inputs = scenes::inputs(&args.input)?;
     if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).map_err(|e| anyhow!("{}: {e}", dir.display()))?;
+        check_out_names(args, &inputs, dir)?;
     }
     let tol = Tolerances {
         max_coverage_diff: args.max_coverage_diff,
@@ -135,4 +135,32 @@ pub fn run(args: &CompareArgs) -> Result<bool> {
         }
     }
     Ok(passed)
+}
+
+/// Refuses, before rendering, `--out` files that would overwrite an input or each other (two
+/// scenes with one stem), and creates the folder.
+fn check_out_names(args: &CompareArgs, inputs: &[scenes::Input], dir: &Path) -> Result<()> {
+    let mut guard = crate::output_plan::OutputGuard::new(inputs);
+    let n = args.backends.len();
+    for input in inputs {
+        let stem = input.stem();
+        for b in &args.backends {
+            guard.add(&dir.join(format!("{stem}-{}.png", b.name())))?;
+        }
+        for i in 0..n {
+            for j in i + 1..n {
+                let name = if n == 2 {
+                    format!("{stem}-diff.png")
+                } else {
+                    format!(
+                        "{stem}-{}-vs-{}-diff.png",
+                        args.backends[i].name(),
+                        args.backends[j].name()
+                    )
+                };
+                guard.add(&dir.join(name))?;
+            }
+        }
+    }
+    crate::output_plan::create_folder(dir)
 }

@@ -11,21 +11,29 @@
 //!   ([`bench`](mod@bench)).
 //! - `compare` renders with several backends and measures how far the pictures differ, exiting
 //!   with 1 when a tolerance is broken ([`compare_cmd`]).
+//! - `thumbnail` writes a square PNG framed on a transparent background ([`thumbnail`]).
 //! - `view` opens a window with an orbit camera (winit + softbuffer, [`view`]).
 //!
 //! The argument definitions are in [`cli`], and backend construction is in [`backends`].
 //! Errors are printed as one line, `kantele: error: …`, on stderr and exit with status 2. This
 //! crate is the only place where Kantele talks to people. The libraries return typed errors.
 
+mod animation;
 mod backends;
 mod bench;
+mod camera_args;
 mod cli;
 mod compare;
 mod compare_cmd;
+mod frame_files;
 mod info;
 mod output;
+mod output_plan;
 mod render_cmd;
 mod scenes;
+mod signals;
+mod thumbnail;
+#[cfg(feature = "viewer")]
 mod view;
 
 use std::process::ExitCode;
@@ -44,6 +52,43 @@ fn one_line(s: &str) -> String {
     s.split_whitespace().collect::<Vec<_>>().join(" ")
 }
 
+/// `kantele view` (needs the `viewer` feature).
+#[cfg(feature = "viewer")]
+fn run_view(args: cli::ViewArgs) -> anyhow::Result<()> {
+    view::run(args)
+}
+
+/// `kantele view` in a build without the viewer.
+#[cfg(not(feature = "viewer"))]
+fn run_view(_: cli::ViewArgs) -> anyhow::Result<()> {
+    anyhow::bail!("view: this kantele was built without the window viewer (cargo install --locked --path crates/kantele-cli --features viewer)")
+}
+
+/// clap's usage error as one line: the problem, what is missing, and its tips ("a similar
+/// argument exists"), without the usage block.
+fn usage_error_line(text: &str) -> String {
+    let mut parts: Vec<String> = Vec::new();
+    for line in text.lines() {
+        let line = line.trim();
+        if line.starts_with("Usage:") || line.starts_with("For more information") {
+            break;
+        }
+        if !line.is_empty() {
+            parts.push(line.strip_prefix("error: ").unwrap_or(line).to_string());
+        }
+    }
+    if parts.is_empty() {
+        parts.push("invalid arguments".into());
+    }
+    let mut message = parts[0].clone();
+    for p in &parts[1..] {
+        let sep = if message.ends_with(':') { " " } else { "; " };
+        message.push_str(sep);
+        message.push_str(p);
+    }
+    format!("{} (see kantele --help)", one_line(&message))
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -56,10 +101,7 @@ fn main() -> ExitCode {
             return ExitCode::from(EXIT_ERROR);
         }
         Err(e) => {
-            let text = e.to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments");
-            let first = first.strip_prefix("error: ").unwrap_or(first);
-            eprintln!("kantele: error: {} (see kantele --help)", one_line(first));
+            eprintln!("kantele: error: {}", usage_error_line(&e.to_string()));
             return ExitCode::from(EXIT_ERROR);
         }
     };
@@ -68,14 +110,41 @@ fn main() -> ExitCode {
         Command::Info(args) => info::run(&args).map(|()| true),
         Command::Bench(args) => bench::run(&args).map(|()| true),
         Command::Compare(args) => compare_cmd::run(&args),
-        Command::View(args) => view::run(args).map(|()| true),
+        Command::View(args) => run_view(args).map(|()| true),
+        Command::Thumbnail(args) => thumbnail::run(&args).map(|()| true),
     };
     match result {
         Ok(true) => ExitCode::SUCCESS,
         Ok(false) => ExitCode::from(EXIT_TOLERANCE),
+        Err(e) if e.is::<signals::Interrupted>() => {
+            eprintln!("kantele: {e}");
+            ExitCode::from(signals::EXIT_INTERRUPTED)
+        }
         Err(e) => {
             eprintln!("kantele: error: {}", one_line(&format!("{e:#}")));
             ExitCode::from(EXIT_ERROR)
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use clap::Parser;
+
+    fn error_of(args: &[&str]) -> String {
+        usage_error_line(&Cli::try_parse_from(args).unwrap_err().to_string())
+    }
+
+    #[test]
+    fn usage_errors_keep_clap_hints() {
+        let missing = error_of(&["kantele", "render", "bunny.glb"]);
+        assert!(missing.contains("--output"), "{missing}");
+        let similar = error_of(&["kantele", "render", "x.glb", "--ouput", "a.png"]);
+        assert!(
+            similar.contains("similar argument exists: '--output'"),
+            "{similar}"
+        );
+        assert!(!missing.contains('\n') && !similar.contains("Usage"));
     }
 }

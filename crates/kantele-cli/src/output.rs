@@ -1,9 +1,7 @@
 //! Output file names: templates with `{stem}`, `{index}` and `{frame}`. The writers themselves
 //! are in [`kantele_io::output`] (shared with the Python package).
 
-pub use kantele_io::output::{
-    write_atomic, write_exr_rgb32f, write_exr_rgba32f, write_pfm, write_png_rgb16, write_png_rgba8,
-};
+pub use kantele_io::output::write_png_rgba8;
 
 use std::path::Path;
 

@@ -1,7 +1,7 @@
-//! `kantele render`: colour, depth, normal and id images with a JSON sidecar.
+//! `kantele render`: colour, depth, normal and id images with a JSON sidecar, each image's
+//! files written together ([`OutputSet`]), checked before anything is rendered.
 
-use std::collections::HashSet;
-use std::io::IsTerminal;
+use std::io::{IsTerminal, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -10,76 +10,102 @@ use anyhow::{anyhow, bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::scene::Scene;
-use kantele_io::pose::sidecar::{
-    DrawId, InstanceId, SidecarCamera, SidecarDepth, SidecarIds, SidecarNormals, ID_CHANNELS,
-    MATRIX_LAYOUT,
-};
-use kantele_io::pose::{rows, Bounds, CameraPose, Sidecar, UpAxis};
+use kantele_io::output::{encode_png_rgba8, OutputSet};
+use kantele_io::pose::sidecar::{DrawId, InstanceId, SidecarCamera, SidecarDepth, SidecarIds};
+use kantele_io::pose::sidecar::{SidecarNormals, MATRIX_LAYOUT};
+use kantele_io::pose::{rows, CameraPose, Sidecar};
 use serde_json::json;
 
+use crate::animation::{is_animation, Animation, ANIMATION_TYPES};
 use crate::backends::make_backend;
-use crate::cli::{DepthKind, RenderArgs};
-use crate::output::{self, digits_for, expand_template, extension, has_placeholder, TemplateVars};
+use crate::camera_args::CameraPlan;
+use crate::cli::{DepthKind, DepthUnit, NormalSpace, RenderArgs};
+use crate::frame_files::{self as files, FramePaths};
+use crate::output::{digits_for, expand_template, extension, has_placeholder, TemplateVars};
+use crate::output_plan::OutputGuard;
 use crate::scenes::{self, Input, Warnings};
+use crate::signals::InterruptFlag;
 
-/// Elevation of the orbit cameras above the bounding sphere's equator.
-pub const ORBIT_ELEVATION_DEG: f32 = 20.0;
+/// The colour output name that means standard output.
+pub const STDOUT: &str = "-";
 
-/// Vertical field of view of the orbit cameras, degrees.
-pub const ORBIT_YFOV_DEG: f32 = 45.0;
+/// What the id files hold, for the sidecar.
+const ID_FILES: &str = "one channel per file (see files), 0 = background: instance = node_index + 1, mesh = mesh index + 1, material = material index + 1, primitive = draw id (draw index + 1), triangle = triangle index in its draw + 1";
 
-/// The files one image writes.
-#[derive(Clone, Debug)]
-struct Outputs {
-    color: PathBuf,
-    sidecar: PathBuf,
-    depth: Option<PathBuf>,
-    normals: Option<PathBuf>,
-    ids: Option<PathBuf>,
+/// The unit of eye and ray depth: `--depth-unit`, else millimetres for PNG and metres otherwise.
+fn depth_unit(args: &RenderArgs) -> DepthUnit {
+    args.extra.depth_unit.unwrap_or_else(|| {
+        match args.extra.depth.as_deref().map(|d| extension(Path::new(d))) {
+            Some(e) if e == "png" => DepthUnit::Mm,
+            _ => DepthUnit::M,
+        }
+    })
 }
 
-fn check_ext(template: &str, flag: &str, allowed: &[&str]) -> Result<()> {
-    let ext = extension(Path::new(template));
-    if !allowed.contains(&ext.as_str()) {
-        bail!(
-            "{template}: unsupported file type for {flag} (use {})",
-            allowed
-                .iter()
-                .map(|e| format!(".{e}"))
-                .collect::<Vec<_>>()
-                .join(" or ")
-        );
+/// Checks file types and flag combinations that need no scene.
+fn check_flags(args: &RenderArgs) -> Result<()> {
+    if args.output == STDOUT && args.json {
+        bail!("-o - and --json would both write to standard output; use one");
+    }
+    if is_animation(&args.output) {
+        let e = &args.extra;
+        if e.depth.is_some() || e.normals.is_some() || !e.ids.is_empty() {
+            bail!("{}: an animation holds colour only; write depth, normals and ids with a numbered -o (.png)", args.output);
+        }
+    } else if args.output != STDOUT {
+        let mut types = files::COLOR_TYPES.to_vec();
+        types.extend_from_slice(ANIMATION_TYPES);
+        files::check_type(&args.output, "-o", &types)?;
+    }
+    let extra = &args.extra;
+    if let Some(d) = &extra.depth {
+        files::check_type(d, "--depth", files::DEPTH_TYPES)?;
+        if extension(Path::new(d)) == "png" && extra.depth_kind == DepthKind::Window {
+            bail!("{d}: window depth in [0, 1] does not fit a 16-bit integer PNG; use .exr, .pfm or .npy");
+        }
+    }
+    if extra.depth_unit.is_some() && extra.depth_kind == DepthKind::Window {
+        bail!("--depth-unit applies to eye and ray depth, not window depth");
+    }
+    if let Some(n) = &extra.normals {
+        files::check_type(n, "--normals", files::NORMAL_TYPES)?;
+    }
+    for (_, f) in &extra.ids {
+        files::check_type(f, "--ids", files::ID_TYPES)?;
     }
     Ok(())
 }
 
-/// Expands every output name and checks that no two images write the same file.
-fn plan_outputs(args: &RenderArgs, inputs: &[Input], views: usize) -> Result<Vec<Vec<Outputs>>> {
-    check_ext(&args.output, "-o", &["png", "exr"])?;
-    let optional = [
-        (&args.depth, "--depth", &["pfm", "exr"][..]),
-        (&args.normals, "--normals", &["png", "exr"][..]),
-        (&args.ids, "--ids", &["png", "exr"][..]),
-    ];
-    for (template, flag, allowed) in optional {
-        if let Some(t) = template {
-            check_ext(t, flag, allowed)?;
-        }
-    }
+/// Expands every output name; refuses names shared by two files or with an input, and
+/// creates the output folders.
+fn plan_outputs(
+    args: &RenderArgs,
+    inputs: &[Input],
+    views: usize,
+    guard: &mut OutputGuard,
+) -> Result<Vec<Vec<FramePaths>>> {
+    // An animation holds every view of a scene in one file.
+    let views = if is_animation(&args.output) { 1 } else { views };
     let total = inputs.len() * views;
+    let extra = &args.extra;
+    let templates: Vec<&String> = std::iter::once(&args.output)
+        .chain(&extra.depth)
+        .chain(&extra.normals)
+        .chain(extra.ids.iter().map(|(_, f)| f))
+        .collect();
+    if args.output == STDOUT && (total > 1 || templates.len() > 1) {
+        bail!("-o -: standard output takes one colour image only (no other outputs, one scene, one view)");
+    }
     if total > 1 {
-        let all = std::iter::once(&args.output).chain(optional.iter().filter_map(|o| o.0.as_ref()));
-        for t in all {
+        for t in &templates {
             if !has_placeholder(t) {
                 bail!(
-                    "{t}: {} images would be written to one file: use {{stem}}, {{index}} or {{frame}} in the name",
-                    total
+                    "{t}: {total} images would be written to one file: use {{stem}}, {{index}} or {{frame}} in the name"
                 );
             }
         }
     }
     let digits = digits_for(total.max(views));
-    let mut seen = HashSet::new();
     let mut plan = Vec::new();
     for (i, input) in inputs.iter().enumerate() {
         let stem = input.stem();
@@ -93,116 +119,43 @@ fn plan_outputs(args: &RenderArgs, inputs: &[Input], views: usize) -> Result<Vec
             let expand = |t: &String| -> Result<PathBuf> {
                 Ok(PathBuf::from(expand_template(t, &vars, digits)?))
             };
-            let color = expand(&args.output)?;
-            let mut sidecar = color.clone().into_os_string();
-            sidecar.push(".json");
-            let o = Outputs {
-                sidecar: PathBuf::from(sidecar),
-                color,
-                depth: args.depth.as_ref().map(expand).transpose()?,
-                normals: args.normals.as_ref().map(expand).transpose()?,
-                ids: args.ids.as_ref().map(expand).transpose()?,
+            let color = if args.output == STDOUT {
+                None
+            } else {
+                Some(expand(&args.output)?)
             };
-            for p in [
-                Some(&o.color),
-                Some(&o.sidecar),
-                o.depth.as_ref(),
-                o.normals.as_ref(),
-                o.ids.as_ref(),
-            ]
-            .into_iter()
-            .flatten()
-            {
-                if !seen.insert(p.clone()) {
-                    bail!(
-                        "{}: would be written more than once (make the output names unique with {{stem}}, {{index}} or {{frame}})",
-                        p.display()
-                    );
-                }
+            let sidecar = color
+                .as_ref()
+                .filter(|_| !is_animation(&args.output))
+                .map(|c| {
+                    let mut s = c.clone().into_os_string();
+                    s.push(".json");
+                    PathBuf::from(s)
+                });
+            let paths = FramePaths {
+                color,
+                sidecar,
+                depth: extra.depth.as_ref().map(expand).transpose()?,
+                normals: extra.normals.as_ref().map(expand).transpose()?,
+                ids: extra
+                    .ids
+                    .iter()
+                    .map(|(k, f)| Ok((*k, expand(f)?)))
+                    .collect::<Result<_>>()?,
+            };
+            for p in paths.all() {
+                guard.add(p)?;
             }
-            per_view.push(o);
+            per_view.push(paths);
         }
         plan.push(per_view);
     }
+    guard.create_folders()?;
     Ok(plan)
 }
 
-/// The cameras of one scene at `width × height`: its own, or `n` orbit views.
-fn cameras(
-    scene: &Scene,
-    orbit: Option<u32>,
-    width: u32,
-    height: u32,
-    label: &str,
-) -> Result<Vec<CameraPose>> {
-    let Some(n) = orbit else {
-        let pose = CameraPose::from_scene_camera(&scene.camera, width, height)
-            .map_err(|e| anyhow!("{label}: camera: {e}"))?;
-        return Ok(vec![pose]);
-    };
-    let bounds = Bounds::of_scene(scene)
-        .ok_or_else(|| anyhow!("{label}: the scene draws nothing, so there is nothing to orbit"))?;
-    CameraPose::orbit(
-        &bounds,
-        n,
-        ORBIT_ELEVATION_DEG,
-        None,
-        UpAxis::Y,
-        ORBIT_YFOV_DEG.to_radians(),
-        width,
-        height,
-    )
-    .map_err(|e| anyhow!("{label}: {e}"))
-}
-
-/// Highest ids of a scene's id pass: (instance, primitive, draw).
-fn max_ids(scene: &Scene) -> (u64, u64, u64) {
-    let instance = scene
-        .draws
-        .iter()
-        .map(|d| d.node_index as u64 + 1)
-        .max()
-        .unwrap_or(0);
-    let primitive = scene
-        .draws
-        .iter()
-        .filter_map(|d| scene.meshes.get(d.mesh))
-        .map(|m| m.triangle_count() as u64)
-        .max()
-        .unwrap_or(0);
-    (instance, primitive, scene.draws.len() as u64)
-}
-
-fn check_id_range(scene: &Scene, ids_path: &Path) -> Result<()> {
-    let (i, p, d) = max_ids(scene);
-    let largest = i.max(p).max(d);
-    let (limit, what) = match extension(ids_path).as_str() {
-        "png" => (
-            65535u64,
-            "16-bit PNG cannot hold them; write the ids to .exr instead",
-        ),
-        _ => (
-            1 << 24,
-            "float EXR channels hold integers exactly only up to 2^24",
-        ),
-    };
-    if largest > limit {
-        bail!(
-            "{}: ids reach {largest} (instances {i}, primitives {p}, draws {d}): {what}",
-            ids_path.display()
-        );
-    }
-    Ok(())
-}
-
-struct Rendered {
-    color: FrameImage,
-    normals: Option<FrameImage>,
-    ids: Option<FrameImage>,
-    ms: f64,
-}
-
-fn render_pass(
+/// Renders one pass and checks the frame's size.
+pub fn render_pass(
     backend: &mut dyn Backend,
     view: &FrameView,
     label: &str,
@@ -228,121 +181,47 @@ fn render_pass(
     Ok((frame, ms))
 }
 
-fn write_color(path: &Path, frame: &FrameImage) -> Result<()> {
-    if extension(path) == "exr" {
-        let data: Vec<f32> = frame.color.iter().flatten().copied().collect();
-        output::write_exr_rgba32f(path, frame.width, frame.height, &data)?;
-    } else {
-        output::write_png_rgba8(path, frame.width, frame.height, &frame.to_rgba8(true))?;
-    }
-    Ok(())
-}
-
-fn depth_values(frame: &FrameImage, kind: DepthKind, pose: &CameraPose) -> Vec<f32> {
-    match kind {
-        DepthKind::Window => frame.depth.clone(),
-        DepthKind::Eye => pose.planar_depth(&frame.depth),
-    }
-}
-
-fn write_depth(path: &Path, frame: &FrameImage, values: &[f32]) -> Result<()> {
-    if extension(path) == "exr" {
-        let rgb: Vec<f32> = values.iter().flat_map(|&v| [v, v, v]).collect();
-        output::write_exr_rgb32f(path, frame.width, frame.height, &rgb)?;
-    } else {
-        output::write_pfm(path, frame.width, frame.height, values)?;
-    }
-    Ok(())
-}
-
-fn write_normals(path: &Path, frame: &FrameImage) -> Result<()> {
-    let covered = |i: usize| frame.depth[i] < 1.0;
-    if extension(path) == "exr" {
-        let rgb: Vec<f32> = (0..frame.color.len())
-            .flat_map(|i| {
-                let c = frame.color[i];
-                if covered(i) {
-                    [c[0], c[1], c[2]]
-                } else {
-                    [0.0; 3]
-                }
-            })
-            .collect();
-        output::write_exr_rgb32f(path, frame.width, frame.height, &rgb)?;
-    } else {
-        let enc = |v: f32| ((v * 0.5 + 0.5).clamp(0.0, 1.0) * 255.0).round() as u8;
-        let rgba: Vec<u8> = (0..frame.color.len())
-            .flat_map(|i| {
-                let c = frame.color[i];
-                if covered(i) {
-                    [enc(c[0]), enc(c[1]), enc(c[2]), 255]
-                } else {
-                    [0; 4]
-                }
-            })
-            .collect();
-        output::write_png_rgba8(path, frame.width, frame.height, &rgba)?;
-    }
-    Ok(())
-}
-
-fn write_ids(path: &Path, frame: &FrameImage) -> Result<()> {
-    let id = |v: f32| -> Result<u32> {
-        if v.is_finite() && v >= 0.0 && v.fract() == 0.0 && v <= 16_777_216.0 {
-            Ok(v as u32)
-        } else {
-            Err(anyhow!(
-                "{}: the backend's id pass holds a non-integer id {v}",
-                path.display()
-            ))
-        }
+/// The sidecar's depth entry.
+fn depth_entry(args: &RenderArgs, file: Option<String>) -> SidecarDepth {
+    let png = file
+        .as_deref()
+        .is_some_and(|f| extension(Path::new(f)) == "png");
+    let what = match args.extra.depth_kind {
+        DepthKind::Window => return SidecarDepth::window(file),
+        DepthKind::Eye => "distance along the camera's view axis (-z in OpenGL eye space, +z in OpenCV camera space)",
+        DepthKind::Ray => "distance from the camera centre to the surface point",
     };
-    if extension(path) == "exr" {
-        let rgb: Vec<f32> = frame
-            .color
-            .iter()
-            .flat_map(|c| [c[0], c[1], c[2]])
-            .collect();
-        for &v in &rgb {
-            id(v)?;
-        }
-        output::write_exr_rgb32f(path, frame.width, frame.height, &rgb)?;
-    } else {
-        let mut rgb = Vec::with_capacity(frame.color.len() * 3);
-        for c in &frame.color {
-            for &v in &c[..3] {
-                let v = id(v)?;
-                let v = u16::try_from(v).map_err(|_| {
-                    anyhow!(
-                        "{}: id {v} does not fit 16-bit PNG; write the ids to .exr instead",
-                        path.display()
-                    )
-                })?;
-                rgb.push(v);
-            }
-        }
-        output::write_png_rgb16(path, frame.width, frame.height, &rgb)?;
+    let unit = match depth_unit(args) {
+        DepthUnit::M => "scene units",
+        DepthUnit::Mm => "millimetres (scene units x 1000)",
+    };
+    let mut entry = SidecarDepth::eye(file);
+    if args.extra.depth_kind == DepthKind::Ray {
+        entry.kind = "ray".into();
     }
-    Ok(())
+    if png {
+        entry.description = format!("{what}, {unit}, rounded to 16-bit integers");
+        entry.background = serde_json::Value::from(0);
+    } else {
+        entry.description = format!("{what}, {unit}, 32-bit float");
+    }
+    entry
 }
 
-#[allow(clippy::too_many_arguments)]
-fn sidecar(
-    args: &RenderArgs,
-    input: &Input,
-    loaded_source: &str,
-    scene: &Scene,
-    pose: &CameraPose,
-    out: &Outputs,
-    backend: &dyn Backend,
+/// Everything the sidecar of one image needs.
+struct SidecarInputs<'a> {
+    input: &'a Input,
+    source: &'a str,
+    scene: &'a Scene,
+    pose: &'a CameraPose,
+    paths: &'a FramePaths,
+    backend: &'a dyn Backend,
     ms: f64,
-) -> Sidecar {
+}
+
+fn sidecar(args: &RenderArgs, s: &SidecarInputs<'_>) -> Sidecar {
     let path = |p: &PathBuf| p.display().to_string();
-    let depth_file = out.depth.as_ref().map(path);
-    let depth = match args.depth_kind {
-        DepthKind::Eye => SidecarDepth::eye(depth_file),
-        DepthKind::Window => SidecarDepth::window(depth_file),
-    };
+    let scene = s.scene;
     let mut instances = std::collections::BTreeMap::new();
     for d in &scene.draws {
         instances
@@ -373,139 +252,229 @@ fn sidecar(
             node_name: d.node_name.clone(),
         })
         .collect();
+    let normals_space = match args.extra.normals_space {
+        NormalSpace::World => "world-space",
+        NormalSpace::Camera => "camera-space (OpenCV axes: x right, y down, z forward)",
+    };
     Sidecar {
-        scene: input.stem(),
-        source: loaded_source.to_string(),
-        output: path(&out.color),
-        width: pose.width,
-        height: pose.height,
-        backend: backend.name().to_string(),
-        renderer: backend.renderer(),
-        threads: backend.threads(),
-        render_ms: ms,
-        camera: SidecarCamera::of_pose(pose),
-        world_to_camera_gl: rows(&pose.view()),
-        world_to_camera_opencv: rows(&pose.world_to_camera_opencv()),
+        scene: s.input.stem(),
+        source: s.source.to_string(),
+        output: s.paths.color.as_ref().map(path).unwrap_or_else(|| "-".into()),
+        width: s.pose.width,
+        height: s.pose.height,
+        backend: s.backend.name().to_string(),
+        renderer: s.backend.renderer(),
+        threads: s.backend.threads(),
+        render_ms: s.ms,
+        camera: SidecarCamera::of_pose(s.pose),
+        world_to_camera_gl: rows(&s.pose.view()),
+        world_to_camera_opencv: rows(&s.pose.world_to_camera_opencv()),
         matrix_layout: MATRIX_LAYOUT.into(),
-        depth,
-        normals: out.normals.as_ref().map(|p| SidecarNormals {
+        depth: depth_entry(args, s.paths.depth.as_ref().map(path)),
+        normals: s.paths.normals.as_ref().map(|p| SidecarNormals {
             file: path(p),
-            encoding: if extension(p) == "exr" {
-                "world-space unit normal as float RGB, background 0"
-            } else {
-                "world-space unit normal n as 8-bit linear (n * 0.5 + 0.5) * 255 in RGB, alpha 255; background 0 0 0 0"
-            }
-            .into(),
+            encoding: match extension(p).as_str() {
+                "exr" => format!("{normals_space} unit normal as float RGB, background 0"),
+                "npy" => format!("{normals_space} unit normal, float32 (H, W, 3), background 0"),
+                _ => format!("{normals_space} unit normal n as 8-bit linear (n * 0.5 + 0.5) * 255 in RGB, alpha 255; background 0 0 0 0"),
+            },
         }),
         ids: SidecarIds {
-            file: out.ids.as_ref().map(path),
-            channels: ID_CHANNELS.into(),
+            file: None,
+            channels: ID_FILES.into(),
+            files: s
+                .paths
+                .ids
+                .iter()
+                .map(|(k, p)| (k.name().to_string(), path(p)))
+                .collect(),
             instance_ids,
             draw_ids,
         },
     }
 }
 
+/// One scene's state while its views are rendered.
+struct SceneJob<'a> {
+    args: &'a RenderArgs,
+    input: &'a Input,
+    label: String,
+    source: String,
+    scene: Arc<Scene>,
+}
+
+impl SceneJob<'_> {
+    /// Renders one view and writes its files together; an interrupt drops them all.
+    fn render_view(
+        &self,
+        backend: &mut dyn Backend,
+        pose: &CameraPose,
+        paths: &FramePaths,
+        interrupt: &InterruptFlag,
+    ) -> Result<f64> {
+        let (args, label, scene) = (self.args, &self.label, &self.scene);
+        let mut view = pose.frame_view(scene, Pass::Color);
+        let (color, ms) = render_pass(backend, &view, label)?;
+        interrupt.check()?;
+        let Some(color_path) = &paths.color else {
+            let rgba = color.to_rgba8(true);
+            let mut buffer = std::io::Cursor::new(Vec::new());
+            encode_png_rgba8(&mut buffer, color.width, color.height, &rgba)
+                .map_err(|e| anyhow!("standard output: {e}"))?;
+            let mut out = std::io::stdout().lock();
+            out.write_all(buffer.get_ref())
+                .and_then(|()| out.flush())
+                .map_err(|e| anyhow!("standard output: {e}"))?;
+            return Ok(ms);
+        };
+        let mut set = OutputSet::new();
+        files::write_color(&mut set, color_path, &color)?;
+        if let Some(p) = &paths.depth {
+            let values = files::depth_values(&color, args.extra.depth_kind, depth_unit(args), pose);
+            files::write_depth(&mut set, p, &color, &values)?;
+        }
+        if let Some(p) = &paths.normals {
+            view.pass = Pass::Normals;
+            let frame = render_pass(backend, &view, label)?.0;
+            interrupt.check()?;
+            let normals = files::normal_values(&frame, args.extra.normals_space, pose);
+            files::write_normals(&mut set, p, &frame, &normals)?;
+        }
+        if !paths.ids.is_empty() {
+            view.pass = Pass::Ids;
+            let frame = render_pass(backend, &view, label)?.0;
+            interrupt.check()?;
+            for (kind, p) in &paths.ids {
+                let ids = files::id_values(&frame, scene, *kind)
+                    .map_err(|e| anyhow!("{}: {e}", p.display()))?;
+                files::write_ids(&mut set, p, &frame, &ids)?;
+            }
+        }
+        if let Some(p) = &paths.sidecar {
+            let meta = sidecar(
+                args,
+                &SidecarInputs {
+                    input: self.input,
+                    source: &self.source,
+                    scene,
+                    pose,
+                    paths,
+                    backend: &*backend,
+                    ms,
+                },
+            );
+            files::write_json(&mut set, p, &meta)?;
+        }
+        interrupt.check()?;
+        set.commit()?;
+        Ok(ms)
+    }
+}
+
+fn progress_bar(total: usize) -> ProgressBar {
+    if !std::io::stderr().is_terminal() {
+        return ProgressBar::hidden();
+    }
+    let pb = ProgressBar::new(total as u64);
+    if let Ok(style) =
+        ProgressStyle::with_template("{spinner} {pos}/{len} {msg} [{elapsed_precise}{eta_suffix}]")
+    {
+        pb.set_style(style.with_key(
+            "eta_suffix",
+            |state: &indicatif::ProgressState, w: &mut dyn std::fmt::Write| {
+                if state.pos() > 0 && state.pos() < state.len().unwrap_or(0) {
+                    let _ = write!(w, " < {}", indicatif::HumanDuration(state.eta()));
+                }
+            },
+        ));
+    }
+    pb.enable_steady_tick(std::time::Duration::from_millis(200));
+    pb
+}
+
 /// Runs `kantele render`.
 pub fn run(args: &RenderArgs) -> Result<()> {
+    let interrupt = InterruptFlag::install()?;
+    check_flags(args)?;
     let inputs = scenes::inputs(&args.input)?;
-    let views = args.orbit.unwrap_or(1) as usize;
-    let plan = plan_outputs(args, &inputs, views)?;
+    let cameras = CameraPlan::new(&args.camera, args.size)?;
+    let views = cameras.views_per_scene();
+    let mut guard = OutputGuard::new(&inputs);
+    if let Some(v) = &args.camera.views {
+        guard.protect(v);
+    }
+    let plan = plan_outputs(args, &inputs, views, &mut guard)?;
     let total = inputs.len() * views;
 
     let mut backend = make_backend(args.backend, &args.cpu, false)?;
-    let progress = if total > 1 && std::io::stderr().is_terminal() {
-        let pb = ProgressBar::new(total as u64);
-        if let Ok(style) =
-            ProgressStyle::with_template("{bar:40} {pos}/{len} {msg} [{elapsed_precise} < {eta}]")
-        {
-            pb.set_style(style);
-        }
-        pb
-    } else {
-        ProgressBar::hidden()
-    };
+    let progress = progress_bar(total);
     let mut warnings = Warnings::default();
 
     for (input, outs) in inputs.iter().zip(&plan) {
+        interrupt.check()?;
+        let done = |paths: &FramePaths| paths.color.is_some() && paths.all().all(|p| p.exists());
+        if args.skip_existing && outs.iter().all(done) {
+            progress.inc(outs.len() as u64);
+            continue;
+        }
         let label = input.label();
         progress.set_message(input.stem());
-        let loaded = input.load()?;
+        let mut loaded = input.load()?;
         warnings.report(&loaded, |w| progress.suspend(|| eprintln!("{w}")));
-        let source = loaded.info.source.clone();
-        let scene = Arc::new(loaded.scene);
-        let (width, height) = match args.size {
-            Some(s) => s,
-            None => {
-                let (w, h) = scene.resolution;
-                if w == 0 || h == 0 || w > kantele::MAX_TARGET_SIZE || h > kantele::MAX_TARGET_SIZE
-                {
-                    bail!("{label}: the scene asks for an image of {w}x{h}, outside 1..={}; use --size", kantele::MAX_TARGET_SIZE);
-                }
-                (w, h)
-            }
-        };
-        if let Some(ids) = &args.ids {
-            check_id_range(&scene, Path::new(ids))?;
+        let (width, height) = cameras.image_size(&loaded, args.size, &label)?;
+        let poses = cameras.poses(&loaded, width, height, &label)?;
+        for (kind, p) in outs.iter().flat_map(|o| &o.ids) {
+            files::check_id_range(&loaded.scene, *kind, p)?;
         }
+        if let Some(c) = args.camera.background {
+            loaded.scene.clear_color = glam::Vec4::from_array(c);
+        }
+        let job = SceneJob {
+            args,
+            input,
+            source: loaded.info.source.clone(),
+            scene: Arc::new(loaded.scene),
+            label,
+        };
         backend
-            .load(scene.clone())
-            .map_err(|e| anyhow!("{label}: {e}"))?;
-        let cams = cameras(&scene, args.orbit, width, height, &label)?;
-        for (pose, out) in cams.iter().zip(outs) {
-            let mut view = pose.frame_view(&scene, Pass::Color);
-            let (color, ms) = render_pass(backend.as_mut(), &view, &label)?;
-            let mut rendered = Rendered {
-                color,
-                normals: None,
-                ids: None,
-                ms,
+            .load(job.scene.clone())
+            .map_err(|e| anyhow!("{}: {e}", job.label))?;
+        if is_animation(&args.output) {
+            let Some(path) = &outs[0].color else {
+                bail!("an animation cannot go to standard output");
             };
-            if out.normals.is_some() {
-                view.pass = Pass::Normals;
-                rendered.normals = Some(render_pass(backend.as_mut(), &view, &label)?.0);
+            if args.skip_existing && path.exists() {
+                progress.inc(poses.len() as u64);
+                continue;
             }
-            if out.ids.is_some() {
-                view.pass = Pass::Ids;
-                rendered.ids = Some(render_pass(backend.as_mut(), &view, &label)?.0);
+            let mut animation = Animation::new(width, height, args.fps);
+            for pose in &poses {
+                interrupt.check()?;
+                let view = pose.frame_view(&job.scene, Pass::Color);
+                let frame = render_pass(backend.as_mut(), &view, &job.label)?.0;
+                animation
+                    .push(&frame)
+                    .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+                progress.inc(1);
             }
-            view.pass = Pass::Color;
-
-            write_color(&out.color, &rendered.color)?;
-            if let Some(p) = &out.depth {
-                write_depth(
-                    p,
-                    &rendered.color,
-                    &depth_values(&rendered.color, args.depth_kind, pose),
-                )?;
+            interrupt.check()?;
+            animation.write(path)?;
+            continue;
+        }
+        for (pose, paths) in poses.iter().zip(outs) {
+            interrupt.check()?;
+            if args.skip_existing && done(paths) {
+                progress.inc(1);
+                continue;
             }
-            if let (Some(p), Some(f)) = (&out.normals, &rendered.normals) {
-                write_normals(p, f)?;
-            }
-            if let (Some(p), Some(f)) = (&out.ids, &rendered.ids) {
-                write_ids(p, f)?;
-            }
-            let meta = sidecar(
-                args,
-                input,
-                &source,
-                &scene,
-                pose,
-                out,
-                backend.as_ref(),
-                rendered.ms,
-            );
-            output::write_atomic(&out.sidecar, |w| {
-                serde_json::to_writer_pretty(&mut *w, &meta)?;
-                std::io::Write::write_all(w, b"\n")
-            })?;
+            let ms = job.render_view(backend.as_mut(), pose, paths, &interrupt)?;
             if args.json {
                 let line = json!({
                     "scene": input.stem(),
-                    "output": out.color.display().to_string(),
-                    "width": width,
-                    "height": height,
-                    "ms": rendered.ms,
+                    "output": paths.color.as_ref().map_or("-".into(), |c| c.display().to_string()),
+                    "width": pose.width,
+                    "height": pose.height,
+                    "ms": ms,
                 });
                 progress.suspend(|| println!("{line}"));
             }
@@ -514,134 +483,4 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     }
     progress.finish_and_clear();
     Ok(())
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use glam::Vec3;
-
-    fn synthetic() -> FrameImage {
-        // 3x2: background, then covered pixels with ids / normals / colours.
-        FrameImage {
-            width: 3,
-            height: 2,
-            color: vec![
-                [0.0, 0.0, 0.0, 0.0],
-                [1.0, 2.0, 3.0, 1.0],
-                [300.0, 65535.0, 7.0, 1.0],
-                [0.0, 0.0, 1.0, 1.0],
-                [0.0, -1.0, 0.0, 1.0],
-                [1.0, 0.0, 0.0, 1.0],
-            ],
-            depth: vec![1.0, 0.5, 0.25, 0.75, 0.1, 0.9],
-        }
-    }
-
-    fn tmp(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("kantele-render-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
-    }
-
-    #[test]
-    fn ids_png_is_16_bit_with_exact_values() {
-        let p = tmp("ids.png");
-        let mut ids = synthetic();
-        ids.color[4] = [4.0, 5.0, 6.0, 1.0];
-        write_ids(&p, &ids).unwrap();
-        let img = image::open(&p).unwrap();
-        assert_eq!(img.color(), image::ColorType::Rgb16);
-        let img = img.to_rgb16();
-        assert_eq!(img.get_pixel(0, 0).0, [0, 0, 0]);
-        assert_eq!(img.get_pixel(1, 0).0, [1, 2, 3]);
-        assert_eq!(img.get_pixel(2, 0).0, [300, 65535, 7]);
-        std::fs::remove_file(&p).unwrap();
-
-        let mut big = ids.clone();
-        big.color[1][1] = 65536.0;
-        let err = write_ids(&p, &big).unwrap_err().to_string();
-        assert!(err.contains(".exr"), "{err}");
-        assert!(!p.exists());
-
-        let e = tmp("ids.exr");
-        write_ids(&e, &big).unwrap();
-        let img = image::open(&e).unwrap().to_rgb32f();
-        assert_eq!(img.get_pixel(1, 0).0, [1.0, 65536.0, 3.0]);
-        std::fs::remove_file(&e).unwrap();
-    }
-
-    #[test]
-    fn normals_png_encoding() {
-        let p = tmp("n.png");
-        write_normals(&p, &synthetic()).unwrap();
-        let img = image::open(&p).unwrap().to_rgba8();
-        assert_eq!(img.get_pixel(0, 0).0, [0, 0, 0, 0]);
-        assert_eq!(img.get_pixel(0, 1).0, [128, 128, 255, 255]);
-        assert_eq!(img.get_pixel(1, 1).0, [128, 0, 128, 255]);
-        std::fs::remove_file(&p).unwrap();
-    }
-
-    #[test]
-    fn depth_files() {
-        let frame = synthetic();
-        let view = CameraPose::new(
-            3,
-            2,
-            kantele_io::pose::Projection::Perspective { yfov: 1.0 },
-            0.5,
-            Some(10.0),
-            glam::Mat4::IDENTITY,
-        )
-        .unwrap();
-        let eye = depth_values(&frame, DepthKind::Eye, &view);
-        assert!(eye[0].is_infinite());
-        assert!(eye[1..]
-            .iter()
-            .all(|d| d.is_finite() && *d >= 0.5 && *d <= 10.0));
-        let p = tmp("d.pfm");
-        write_depth(&p, &frame, &eye).unwrap();
-        let (w, h, back) = kantele_io::output::decode_pfm(&std::fs::read(&p).unwrap()).unwrap();
-        assert_eq!((w, h), (3, 2));
-        assert_eq!(back, eye);
-        std::fs::remove_file(&p).unwrap();
-        let e = tmp("d.exr");
-        let window = depth_values(&frame, DepthKind::Window, &view);
-        write_depth(&e, &frame, &window).unwrap();
-        let img = image::open(&e).unwrap().to_rgb32f();
-        assert_eq!(img.get_pixel(0, 0).0, [1.0; 3]);
-        assert_eq!(img.get_pixel(2, 1).0, [0.9; 3]);
-        std::fs::remove_file(&e).unwrap();
-    }
-
-    #[test]
-    fn orbit_cameras_circle_the_scene() {
-        let mut scene = Scene::default();
-        scene.meshes.push(kantele::scene::Mesh {
-            positions: vec![
-                Vec3::new(-1.0, -1.0, -1.0),
-                Vec3::new(1.0, 1.0, 1.0),
-                Vec3::X,
-            ],
-            indices: vec![0, 1, 2],
-            ..Default::default()
-        });
-        scene.materials.push(Default::default());
-        scene.draws.push(kantele::scene::Draw {
-            mesh: 0,
-            model: glam::Mat4::IDENTITY,
-            node_name: "n".into(),
-            node_index: 0,
-        });
-        let cams = cameras(&scene, Some(4), 64, 64, "x").unwrap();
-        assert_eq!(cams.len(), 4);
-        let eyes: Vec<Vec3> = cams.iter().map(|c| c.eye()).collect();
-        let d0 = eyes[0].length();
-        for e in &eyes {
-            assert!((e.length() - d0).abs() < 1e-3);
-            assert!(e.y > 0.0);
-        }
-        assert!(eyes[0].z > 0.0 && eyes[1].x > 0.0 && eyes[2].z < 0.0 && eyes[3].x < 0.0);
-        assert!(cameras(&Scene::default(), Some(2), 64, 64, "x").is_err());
-    }
 }

@@ -1,7 +1,7 @@
 //! Scene inputs (files and built-ins), loading with file-naming errors, warnings printed once.
 
 use std::collections::HashSet;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
 use kantele_io::{LoadOptions, LoadedScene};
@@ -70,26 +70,72 @@ impl Input {
     }
 }
 
-/// The inputs of a command, files first; checks that files exist and built-ins are known
-/// before anything is rendered.
+/// Extensions of scene files found in folders and by patterns.
+pub const SCENE_EXTENSIONS: &[&str] = &["gltf", "glb", "obj"];
+
+fn is_scene_file(path: &Path) -> bool {
+    path.is_file() && SCENE_EXTENSIONS.contains(&crate::output::extension(path).as_str())
+}
+
+/// The scene files of a folder (not its subfolders), sorted by name.
+fn folder_scenes(dir: &Path) -> Result<Vec<PathBuf>> {
+    let entries = std::fs::read_dir(dir)
+        .map_err(|e| anyhow!("{}: cannot list the folder: {e}", dir.display()))?;
+    let mut found: Vec<PathBuf> = entries
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| is_scene_file(p))
+        .collect();
+    found.sort();
+    if found.is_empty() {
+        bail!(
+            "{}: the folder holds no scene files (.gltf, .glb, .obj)",
+            dir.display()
+        );
+    }
+    Ok(found)
+}
+
+/// The scene files matching a glob pattern, sorted.
+fn pattern_scenes(pattern: &str) -> Result<Vec<PathBuf>> {
+    let paths = glob::glob(pattern).map_err(|e| anyhow!("{pattern}: not a valid pattern: {e}"))?;
+    let mut found: Vec<PathBuf> = paths
+        .filter_map(|p| p.ok())
+        .filter(|p| is_scene_file(p))
+        .collect();
+    found.sort();
+    if found.is_empty() {
+        bail!("{pattern}: no scene file (.gltf, .glb, .obj) matches");
+    }
+    Ok(found)
+}
+
+/// The inputs of a command, files first: a folder stands for the scene files in it and a
+/// pattern (`*`, `?`, `[...]`) for the scene files it matches. Checks that files exist and
+/// built-ins are known before anything is rendered.
 pub fn inputs(args: &SceneArgs) -> Result<Vec<Input>> {
     let mut out = Vec::new();
+    let options = LoadOptions {
+        max_memory: args.max_memory.unwrap_or(kantele_io::DEFAULT_MAX_MEMORY),
+        allow_read: args.allow_read.clone(),
+        strict: args.strict,
+        ..LoadOptions::default()
+    };
+    let file = |p: PathBuf| Input::File(p, options.clone());
     for p in &args.scenes {
         match std::fs::metadata(p) {
-            Ok(m) if m.is_file() => {}
+            Ok(m) if m.is_file() => out.push(file(p.clone())),
+            Ok(m) if m.is_dir() => out.extend(folder_scenes(p)?.into_iter().map(file)),
             Ok(_) => bail!("{}: not a file", p.display()),
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-                bail!("{}: no such file", p.display())
+                let text = p.to_string_lossy();
+                if text.contains(['*', '?', '[']) {
+                    out.extend(pattern_scenes(&text)?.into_iter().map(file));
+                } else {
+                    bail!("{}: no such file", p.display())
+                }
             }
             Err(e) => bail!("{}: {e}", p.display()),
         }
-        let options = LoadOptions {
-            max_memory: args.max_memory.unwrap_or(kantele_io::DEFAULT_MAX_MEMORY),
-            allow_read: args.allow_read.clone(),
-            strict: args.strict,
-            ..LoadOptions::default()
-        };
-        out.push(Input::File(p.clone(), options));
     }
     let known = kantele_io::builtin_scenes();
     for n in &args.builtins {

@@ -173,6 +173,10 @@ pub struct SidecarIds {
     pub file: Option<String>,
     /// What each channel holds ([`ID_CHANNELS`]).
     pub channels: String,
+    /// One-channel id files by kind (`instance`, `mesh`, `material`, `primitive` = draw id,
+    /// `triangle` = triangle index in its draw + 1), each 0 on the background.
+    #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
+    pub files: std::collections::BTreeMap<String, String>,
     /// Instance ids and their nodes.
     pub instance_ids: Vec<InstanceId>,
     /// Draw ids and their meshes and nodes.

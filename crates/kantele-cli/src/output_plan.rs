@@ -1,0 +1,250 @@
+//! Checks on output files made before anything is rendered: no two outputs the same file, no
+//! output overwriting an input (a scene file or a file it references), every output folder
+//! created and writable.
+
+use std::collections::HashMap;
+use std::path::{Component, Path, PathBuf};
+
+use anyhow::{anyhow, bail, Result};
+
+use crate::scenes::Input;
+
+/// The identity of a path for comparisons: absolute, `.`/`..` resolved, symbolic links of the
+/// existing part followed.
+pub fn identity(path: &Path) -> PathBuf {
+    if let Ok(p) = std::fs::canonicalize(path) {
+        return p;
+    }
+    let absolute = std::env::current_dir()
+        .map(|d| d.join(path))
+        .unwrap_or_else(|_| path.to_path_buf());
+    // Resolve the longest existing ancestor, then append the rest lexically.
+    let mut existing = absolute.clone();
+    let mut rest = Vec::new();
+    while !existing.exists() {
+        match (existing.file_name(), existing.parent()) {
+            (Some(name), Some(parent)) => {
+                rest.push(name.to_os_string());
+                existing = parent.to_path_buf();
+            }
+            _ => break,
+        }
+    }
+    let mut out = std::fs::canonicalize(&existing).unwrap_or(existing);
+    for part in rest.iter().rev() {
+        out.push(part);
+    }
+    let mut clean = PathBuf::new();
+    for c in out.components() {
+        match c {
+            Component::ParentDir => {
+                clean.pop();
+            }
+            Component::CurDir => {}
+            other => clean.push(other),
+        }
+    }
+    clean
+}
+
+/// Files an input reads: the scene file and, for `.gltf` and `.obj`, the files it names
+/// (buffers, images, MTL libraries and their texture maps) next to it.
+pub fn input_files(input: &Input) -> Vec<PathBuf> {
+    let Input::File(path, _) = input else {
+        return Vec::new();
+    };
+    let mut files = vec![path.clone()];
+    let dir = path.parent().unwrap_or(Path::new(""));
+    match crate::output::extension(path).as_str() {
+        "gltf" => {
+            let Ok(text) = std::fs::read_to_string(path) else {
+                return files;
+            };
+            let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else {
+                return files;
+            };
+            for list in ["buffers", "images"] {
+                for item in json[list].as_array().into_iter().flatten() {
+                    if let Some(uri) = item["uri"].as_str() {
+                        if !uri.starts_with("data:") {
+                            files.push(dir.join(percent_decode(uri)));
+                        }
+                    }
+                }
+            }
+        }
+        "obj" => {
+            let Ok(text) = std::fs::read_to_string(path) else {
+                return files;
+            };
+            for lib in names_after(&text, &["mtllib"]) {
+                let mtl = dir.join(&lib);
+                if let Ok(mtl_text) = std::fs::read_to_string(&mtl) {
+                    let mtl_dir = mtl.parent().unwrap_or(Path::new("")).to_path_buf();
+                    for map in names_after(&mtl_text, &["map_kd", "map_ka", "map_d", "bump"]) {
+                        files.push(mtl_dir.join(map));
+                    }
+                }
+                files.push(mtl);
+            }
+        }
+        _ => {}
+    }
+    files
+}
+
+/// The last word of every line starting with one of `keywords` (case-insensitive).
+fn names_after(text: &str, keywords: &[&str]) -> Vec<String> {
+    text.lines()
+        .filter_map(|line| {
+            let mut words = line.split_whitespace();
+            let first = words.next()?.to_ascii_lowercase();
+            if keywords.contains(&first.as_str()) {
+                words.last().map(str::to_string)
+            } else {
+                None
+            }
+        })
+        .collect()
+}
+
+fn percent_decode(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%' && i + 2 < bytes.len() {
+            if let Ok(b) = u8::from_str_radix(&uri[i + 1..i + 3], 16) {
+                out.push(b);
+                i += 3;
+                continue;
+            }
+        }
+        out.push(bytes[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+/// Collects outputs and refuses duplicates and inputs.
+#[derive(Default)]
+pub struct OutputGuard {
+    inputs: HashMap<PathBuf, PathBuf>,
+    outputs: HashMap<PathBuf, PathBuf>,
+}
+
+impl OutputGuard {
+    /// A guard protecting the files of `inputs`.
+    pub fn new(inputs: &[Input]) -> Self {
+        let mut guard = Self::default();
+        for input in inputs {
+            for f in input_files(input) {
+                guard.inputs.insert(identity(&f), f);
+            }
+        }
+        guard
+    }
+
+    /// Protects one more file (e.g. a `--views` file).
+    pub fn protect(&mut self, path: &Path) {
+        self.inputs.insert(identity(path), path.to_path_buf());
+    }
+
+    /// Records an output; an input or an earlier output at the same place is an error.
+    pub fn add(&mut self, path: &Path) -> Result<()> {
+        let id = identity(path);
+        if let Some(input) = self.inputs.get(&id) {
+            bail!(
+                "{}: would overwrite the input {}; choose another output name",
+                path.display(),
+                input.display()
+            );
+        }
+        if let Some(earlier) = self.outputs.insert(id, path.to_path_buf()) {
+            bail!(
+                "{}: would be written more than once (also as {}); make the output names unique with {{stem}}, {{index}} or {{frame}}",
+                path.display(),
+                earlier.display()
+            );
+        }
+        Ok(())
+    }
+
+    /// Creates every output folder and checks it is a writable folder.
+    pub fn create_folders(&self) -> Result<()> {
+        let mut done = std::collections::HashSet::new();
+        for path in self.outputs.values() {
+            let dir = match path.parent() {
+                Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+                _ => PathBuf::from("."),
+            };
+            if !done.insert(dir.clone()) {
+                continue;
+            }
+            create_folder(&dir)?;
+        }
+        Ok(())
+    }
+}
+
+/// Creates `dir` (and its parents) and checks that a file can be made in it.
+pub fn create_folder(dir: &Path) -> Result<()> {
+    std::fs::create_dir_all(dir)
+        .map_err(|e| anyhow!("{}: cannot create the folder: {e}", dir.display()))?;
+    let probe = dir.join(format!(".kantele-probe-{}", std::process::id()));
+    std::fs::File::create(&probe)
+        .map_err(|e| anyhow!("{}: cannot write in this folder: {e}", dir.display()))?;
+    let _ = std::fs::remove_file(&probe);
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn tmp(tag: &str) -> PathBuf {
+        let d = std::env::temp_dir().join(format!("kantele-plan-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&d);
+        std::fs::create_dir_all(&d).unwrap();
+        d
+    }
+
+    #[test]
+    fn refuses_inputs_and_duplicates() {
+        let d = tmp("guard");
+        std::fs::write(
+            d.join("s.gltf"),
+            r#"{"asset":{"version":"2.0"},"buffers":[{"uri":"b%20in.bin"}],"images":[{"uri":"tex/a.png"},{"uri":"data:x"}]}"#,
+        )
+        .unwrap();
+        let input = Input::File(d.join("s.gltf"), Default::default());
+        let files = input_files(&input);
+        assert!(files.contains(&d.join("b in.bin")));
+        assert!(files.contains(&d.join("tex/a.png")));
+        assert_eq!(files.len(), 3);
+        let mut g = OutputGuard::new(&[input]);
+        assert!(g.add(&d.join("s.gltf")).is_err());
+        assert!(g.add(&d.join("sub/../tex/a.png")).is_err());
+        assert!(g.add(&d.join("out.png")).is_ok());
+        assert!(g.add(&d.join("./out.png")).is_err());
+        g.add(&d.join("new/deeper/x.png")).unwrap();
+        g.create_folders().unwrap();
+        assert!(d.join("new/deeper").is_dir());
+        std::fs::write(d.join("afile"), b"x").unwrap();
+        let mut g2 = OutputGuard::default();
+        g2.add(&d.join("afile/x.png")).unwrap();
+        assert!(g2.create_folders().is_err());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    #[test]
+    fn obj_inputs_include_mtl_and_maps() {
+        let d = tmp("obj");
+        std::fs::write(d.join("m.obj"), "mtllib m.mtl\nv 0 0 0\n").unwrap();
+        std::fs::write(d.join("m.mtl"), "newmtl a\nmap_Kd -s 1 1 1 wood.png\n").unwrap();
+        let files = input_files(&Input::File(d.join("m.obj"), Default::default()));
+        assert!(files.contains(&d.join("m.mtl")));
+        assert!(files.contains(&d.join("wood.png")));
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+}

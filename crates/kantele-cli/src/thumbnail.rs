@@ -1,0 +1,63 @@
+//! `kantele thumbnail IN OUT --size N`: a square PNG of a scene framed by its bounding box on a
+//! transparent background, for file managers (`data/kantele.thumbnailer`).
+
+use std::sync::Arc;
+
+use anyhow::{anyhow, Result};
+use kantele::backend::Pass;
+use kantele_io::output::{encode_png_rgba8, write_atomic};
+
+use crate::backends::make_backend;
+use crate::camera_args::CameraPlan;
+use crate::cli::{BackendKind, CameraArgs, CpuArgs, ThumbnailArgs};
+use crate::output_plan::{create_folder, OutputGuard};
+use crate::scenes::{self, Input};
+
+/// Runs `kantele thumbnail`.
+pub fn run(args: &ThumbnailArgs) -> Result<()> {
+    let mut found = scenes::inputs(&crate::cli::SceneArgs {
+        scenes: vec![args.input.clone()],
+        builtins: Vec::new(),
+        strict: false,
+        max_memory: None,
+        allow_read: Vec::new(),
+    })?;
+    if found.len() != 1 {
+        anyhow::bail!(
+            "{}: a thumbnail is made of one scene file",
+            args.input.display()
+        );
+    }
+    let input: Input = found.remove(0);
+    if crate::output::extension(&args.output) != "png" {
+        anyhow::bail!("{}: a thumbnail is a .png", args.output.display());
+    }
+    let mut guard = OutputGuard::new(std::slice::from_ref(&input));
+    guard.add(&args.output)?;
+    if let Some(dir) = args.output.parent().filter(|d| !d.as_os_str().is_empty()) {
+        create_folder(dir)?;
+    }
+    let label = input.label();
+    let mut loaded = input.load()?;
+    loaded.scene.clear_color = glam::Vec4::ZERO;
+    let plan = CameraPlan::new(
+        &CameraArgs {
+            camera: Some("auto".into()),
+            ..Default::default()
+        },
+        None,
+    )?;
+    let pose = plan.poses(&loaded, args.size, args.size, &label)?.remove(0);
+    let scene = Arc::new(loaded.scene);
+    let mut backend = make_backend(BackendKind::Cpu, &CpuArgs::default(), false)?;
+    backend
+        .load(scene.clone())
+        .map_err(|e| anyhow!("{label}: {e}"))?;
+    let view = pose.frame_view(&scene, Pass::Color);
+    let (frame, _) = crate::render_cmd::render_pass(backend.as_mut(), &view, &label)?;
+    let rgba = frame.to_rgba8(true);
+    write_atomic(&args.output, |w| {
+        encode_png_rgba8(w, frame.width, frame.height, &rgba)
+    })?;
+    Ok(())
+}

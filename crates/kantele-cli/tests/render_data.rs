@@ -1,0 +1,538 @@
+//! End-to-end tests of `kantele render` for dataset work: cameras in (`--camera`, `--views`,
+//! `--orbit`), one-channel id files, BOP depth, standard output, and whole output sets
+//! (inputs protected, Ctrl-C leaves nothing behind).
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+
+const BIN: &str = env!("CARGO_BIN_EXE_kantele");
+
+/// A fresh directory removed on drop.
+struct TempDir(PathBuf);
+
+impl TempDir {
+    fn new(tag: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("kantele-data-{tag}-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        TempDir(dir)
+    }
+    fn path(&self, name: &str) -> PathBuf {
+        self.0.join(name)
+    }
+    fn s(&self, name: &str) -> String {
+        self.path(name).to_string_lossy().into_owned()
+    }
+    fn files(&self) -> Vec<String> {
+        let mut v: Vec<String> = std::fs::read_dir(&self.0)
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    }
+}
+
+impl Drop for TempDir {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.0);
+    }
+}
+
+fn kantele(args: &[&str]) -> Output {
+    Command::new(BIN).args(args).output().expect("run kantele")
+}
+
+fn ok(o: &Output) {
+    assert!(
+        o.status.success(),
+        "kantele failed ({:?}):\n{}",
+        o.status,
+        String::from_utf8_lossy(&o.stderr)
+    );
+}
+
+fn err_line(o: &Output) -> String {
+    assert!(!o.status.success(), "expected a failure");
+    let e = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert!(!e.contains("panicked"), "{e}");
+    assert_eq!(e.trim().lines().count(), 1, "one line: {e}");
+    e
+}
+
+/// Reads a little-endian `.npy` of `<f4` or `<u4` values: (shape, raw 4-byte words).
+fn read_npy(path: &Path) -> (Vec<usize>, String, Vec<[u8; 4]>) {
+    let data = std::fs::read(path).unwrap();
+    assert_eq!(&data[..6], b"\x93NUMPY");
+    let header_len = u16::from_le_bytes([data[8], data[9]]) as usize;
+    let header = std::str::from_utf8(&data[10..10 + header_len]).unwrap();
+    let descr = header.split("'descr': '").nth(1).unwrap()[..3].to_string();
+    let shape_text = header.split("'shape': (").nth(1).unwrap();
+    let shape: Vec<usize> = shape_text[..shape_text.find(')').unwrap()]
+        .split(',')
+        .filter(|s| !s.trim().is_empty())
+        .map(|s| s.trim().parse().unwrap())
+        .collect();
+    let words = data[10 + header_len..]
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect();
+    (shape, descr, words)
+}
+
+/// An OBJ of `n` small triangles in a strip across the unit square (one object).
+fn write_triangle_soup(path: &Path, n: usize) {
+    use std::fmt::Write;
+    let mut s = String::with_capacity(n * 60);
+    let cols = (n as f64).sqrt().ceil() as usize;
+    for i in 0..n {
+        let (x, y) = ((i % cols) as f32, (i / cols) as f32);
+        let k = 1.0 / cols as f32;
+        let _ = writeln!(
+            s,
+            "v {} {} 0\nv {} {} 0\nv {} {} 0",
+            x * k,
+            y * k,
+            (x + 1.0) * k,
+            y * k,
+            x * k,
+            (y + 1.0) * k
+        );
+    }
+    for i in 0..n {
+        let _ = writeln!(s, "f {} {} {}", 3 * i + 1, 3 * i + 2, 3 * i + 3);
+    }
+    std::fs::write(path, s).unwrap();
+}
+
+#[test]
+fn views_file_reproduces_the_sidecar_picture() {
+    let dir = TempDir::new("views");
+    for camera in ["look-at:2.5,1.5,3:0,0,0", "auto"] {
+        let o = kantele(&[
+            "render",
+            "--builtin",
+            "teapot",
+            "--size",
+            "90x60",
+            "--camera",
+            camera,
+            "-o",
+            &dir.s("a.png"),
+        ]);
+        ok(&o);
+        let o = kantele(&[
+            "render",
+            "--builtin",
+            "teapot",
+            "--views",
+            &dir.s("a.png.json"),
+            "-o",
+            &dir.s("b.png"),
+        ]);
+        ok(&o);
+        let a = std::fs::read(dir.path("a.png")).unwrap();
+        let b = std::fs::read(dir.path("b.png")).unwrap();
+        assert!(a == b, "{camera}: the views file gives another picture");
+        let side: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path("b.png.json")).unwrap()).unwrap();
+        assert_eq!(
+            (side["width"].as_u64(), side["height"].as_u64()),
+            (Some(90), Some(60))
+        );
+    }
+}
+
+#[test]
+fn auto_camera_fills_the_picture_on_a_transparent_background() {
+    let dir = TempDir::new("auto");
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "teapot",
+        "--size",
+        "120x80",
+        "--camera",
+        "auto",
+        "--background",
+        "transparent",
+        "-o",
+        &dir.s("t.png"),
+    ]);
+    ok(&o);
+    let img = image::open(dir.path("t.png")).unwrap().to_rgba8();
+    assert_eq!(img.get_pixel(0, 0).0[3], 0, "background is transparent");
+    let (mut x0, mut x1, mut y0, mut y1) = (u32::MAX, 0, u32::MAX, 0);
+    for (x, y, p) in img.enumerate_pixels() {
+        if p.0[3] > 0 {
+            (x0, x1, y0, y1) = (x0.min(x), x1.max(x), y0.min(y), y1.max(y));
+        }
+    }
+    // The box fills the tighter direction; the teapot inside it spans well over half the
+    // picture (the scene camera leaves it at a third) and touches no border.
+    assert!(y1 - y0 >= 45 && x1 - x0 >= 70, "{x0}..{x1} x {y0}..{y1}");
+    assert!(
+        x0 > 0 && y0 > 0 && x1 < 119 && y1 < 79,
+        "{x0}..{x1} x {y0}..{y1}"
+    );
+    let bad = kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "--background",
+        "sky",
+        "-o",
+        &dir.s("x.png"),
+    ]);
+    assert!(err_line(&bad).contains("colour"));
+}
+
+#[test]
+fn instance_mask_of_a_70000_triangle_mesh() {
+    let dir = TempDir::new("bigmesh");
+    let obj = dir.path("soup.obj");
+    write_triangle_soup(&obj, 70_000);
+    // Triangle ids do not fit a 16-bit PNG: refused before rendering, nothing written.
+    let o = kantele(&[
+        "render",
+        &dir.s("soup.obj"),
+        "--size",
+        "64x64",
+        "-o",
+        &dir.s("c.png"),
+        "--ids",
+        &format!("triangle={}", dir.s("t.png")),
+    ]);
+    let e = err_line(&o);
+    assert!(e.contains("t.png") && e.contains("16-bit"), "{e}");
+    assert_eq!(dir.files(), vec!["soup.obj"]);
+    // Instance ids alone fit; triangle ids go to a 32-bit .npy.
+    let o = kantele(&[
+        "render",
+        &dir.s("soup.obj"),
+        "--size",
+        "64x64",
+        "--camera",
+        "look-at:0.5,0.5,1.5:0.5,0.5,0",
+        "-o",
+        &dir.s("c.png"),
+        "--ids",
+        &format!("instance={}", dir.s("i.png")),
+        "--ids",
+        &format!("triangle={}", dir.s("t.npy")),
+    ]);
+    ok(&o);
+    let ids = image::open(dir.path("i.png")).unwrap();
+    assert_eq!(ids.color(), image::ColorType::L16);
+    let ids = ids.to_luma16();
+    let values: std::collections::BTreeSet<u16> = ids.pixels().map(|p| p.0[0]).collect();
+    assert!(
+        values.contains(&1),
+        "the mesh's instance id 1 is in the mask"
+    );
+    assert!(values.iter().all(|v| *v <= 1), "{values:?}");
+    let (shape, descr, words) = read_npy(&dir.path("t.npy"));
+    assert_eq!((shape, descr.as_str()), (vec![64, 64], "<u4"));
+    let tri: Vec<u32> = words.iter().map(|w| u32::from_le_bytes(*w)).collect();
+    assert!(tri.iter().any(|&t| t > 65_536), "high triangle ids present");
+    for (p, t) in ids.pixels().zip(&tri) {
+        assert_eq!(p.0[0] == 0, *t == 0, "masks agree on the background");
+    }
+}
+
+#[test]
+fn bop_depth_in_millimetres_matches_float_depth() {
+    let dir = TempDir::new("bop");
+    let render = |color: &str, kind: &str, depth: &str| {
+        kantele(&[
+            "render",
+            "--builtin",
+            "cube",
+            "--size",
+            "80x60",
+            "-o",
+            color,
+            "--depth-kind",
+            kind,
+            "--depth",
+            depth,
+        ])
+    };
+    // One file as colour and depth: refused before rendering.
+    let same = dir.s("same.png");
+    assert!(err_line(&render(&same, "eye", &same)).contains("more than once"));
+    for kind in ["eye", "ray"] {
+        let (png, npy) = (dir.s(&format!("{kind}.png")), dir.s(&format!("{kind}.npy")));
+        ok(&render(&dir.s("c1.png"), kind, &png));
+        ok(&render(&dir.s("c2.png"), kind, &npy));
+        let mm = image::open(&png).unwrap();
+        assert_eq!(mm.color(), image::ColorType::L16);
+        let mm = mm.to_luma16();
+        let (shape, descr, words) = read_npy(Path::new(&npy));
+        assert_eq!((shape, descr.as_str()), (vec![60, 80], "<f4"));
+        let metres: Vec<f32> = words.iter().map(|w| f32::from_le_bytes(*w)).collect();
+        let mut covered = 0;
+        for (p, m) in mm.pixels().zip(&metres) {
+            if m.is_finite() {
+                covered += 1;
+                assert_eq!(p.0[0], (m * 1000.0).round() as u16);
+            } else {
+                assert_eq!(p.0[0], 0, "background is 0");
+            }
+        }
+        assert!(covered > 100);
+    }
+}
+
+#[test]
+fn png_to_standard_output() {
+    let o = kantele(&["render", "--builtin", "cube", "--size", "20x10", "-o", "-"]);
+    ok(&o);
+    let img = image::load_from_memory(&o.stdout).unwrap();
+    assert_eq!((img.width(), img.height()), (20, 10));
+    let dir = TempDir::new("stdout");
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "-o",
+        "-",
+        "--depth",
+        &dir.s("d.pfm"),
+    ]);
+    assert!(err_line(&o).contains("standard output"));
+}
+
+#[test]
+fn outputs_never_overwrite_inputs() {
+    let dir = TempDir::new("inputs");
+    std::fs::write(
+        dir.path("m.obj"),
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    std::fs::write(dir.path("m.mtl"), "newmtl a\nmap_Kd wood.png\n").unwrap();
+    std::fs::write(dir.path("wood.png"), b"not really a png").unwrap();
+    let o = kantele(&["render", &dir.s("m.obj"), "-o", &dir.s("wood.png")]);
+    let e = err_line(&o);
+    assert!(e.contains("overwrite the input"), "{e}");
+    assert_eq!(
+        std::fs::read(dir.path("wood.png")).unwrap(),
+        b"not really a png"
+    );
+    // Output folders are made before rendering.
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "--size",
+        "16x16",
+        "-o",
+        &dir.s("new/deep/c.png"),
+    ]);
+    ok(&o);
+    assert!(dir.path("new/deep/c.png.json").is_file());
+}
+
+#[cfg(unix)]
+#[test]
+fn interrupt_during_an_orbit_leaves_whole_sets_only() {
+    let dir = TempDir::new("sigint");
+    let child = Command::new(BIN)
+        .args([
+            "render",
+            "--builtin",
+            "teapot",
+            "--size",
+            "400x300",
+            "--orbit",
+            "400",
+            "-o",
+            &dir.s("{frame}.png"),
+            "--depth",
+            &dir.s("{frame}.pfm"),
+        ])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    // Wait for the first finished frame, so the interrupt lands in the middle of the work.
+    let start = Instant::now();
+    while !dir.path("0000.png.json").exists() && start.elapsed() < Duration::from_secs(60) {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    let status = Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let out = child.wait_with_output().unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(130),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let files = dir.files();
+    assert!(
+        !files.is_empty() && files.len() < 3 * 400,
+        "{} files",
+        files.len()
+    );
+    for f in &files {
+        assert!(!f.starts_with('.'), "temporary left behind: {f}");
+        if let Some(stem) = f.strip_suffix(".png.json") {
+            for part in [format!("{stem}.png"), format!("{stem}.pfm")] {
+                assert!(files.contains(&part), "{f} without {part}");
+            }
+        } else {
+            let stem = f.split('.').next().unwrap();
+            assert!(
+                files.contains(&format!("{stem}.png.json")),
+                "{f} without its sidecar"
+            );
+        }
+    }
+}
+
+#[test]
+fn compare_out_refuses_colliding_names_before_rendering() {
+    let dir = TempDir::new("compare-out");
+    for sub in ["a", "b"] {
+        std::fs::create_dir_all(dir.path(sub)).unwrap();
+        std::fs::write(dir.path(&format!("{sub}/x.glb")), b"not a scene").unwrap();
+    }
+    let o = kantele(&[
+        "compare",
+        &dir.s("a/x.glb"),
+        &dir.s("b/x.glb"),
+        "--out",
+        &dir.s("diff"),
+    ]);
+    assert!(err_line(&o).contains("more than once"));
+    assert!(!dir.path("diff").exists(), "nothing made before the check");
+}
+
+#[test]
+fn folders_patterns_and_skip_existing() {
+    let dir = TempDir::new("batch");
+    std::fs::create_dir_all(dir.path("in")).unwrap();
+    for name in ["a", "b"] {
+        std::fs::write(
+            dir.path(&format!("in/{name}.obj")),
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+        )
+        .unwrap();
+    }
+    std::fs::write(dir.path("in/notes.txt"), "not a scene").unwrap();
+    let out = dir.s("out/{stem}.png");
+    let render = |input: &str, extra: &[&str]| {
+        let mut a = vec!["render", input, "--size", "16x16", "-o", &out];
+        a.extend_from_slice(extra);
+        kantele(&a)
+    };
+    ok(&render(&dir.s("in"), &[]));
+    let listing = |d: &TempDir| {
+        let mut v: Vec<String> = std::fs::read_dir(d.path("out"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        v.sort();
+        v
+    };
+    assert_eq!(
+        listing(&dir),
+        ["a.png", "a.png.json", "b.png", "b.png.json"]
+    );
+    // --skip-existing leaves finished images alone and makes the missing ones.
+    std::fs::remove_file(dir.path("out/b.png.json")).unwrap();
+    let before = std::fs::metadata(dir.path("out/a.png"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    std::thread::sleep(Duration::from_millis(20));
+    ok(&render(&dir.s("in/*.obj"), &["--skip-existing"]));
+    let after = std::fs::metadata(dir.path("out/a.png"))
+        .unwrap()
+        .modified()
+        .unwrap();
+    assert_eq!(before, after, "a finished image was rendered again");
+    assert!(dir.path("out/b.png.json").is_file());
+    let none = render(&dir.s("in/*.gltf"), &[]);
+    assert!(err_line(&none).contains("no scene file"));
+}
+
+#[test]
+fn orbit_straight_to_an_animation() {
+    use image::AnimationDecoder;
+    let dir = TempDir::new("turntable");
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "teapot",
+        "--size",
+        "40x30",
+        "--orbit",
+        "6",
+        "--background",
+        "transparent",
+        "-o",
+        &dir.s("spin.gif"),
+    ]);
+    ok(&o);
+    let file = std::io::BufReader::new(std::fs::File::open(dir.path("spin.gif")).unwrap());
+    let frames = image::codecs::gif::GifDecoder::new(file)
+        .unwrap()
+        .into_frames()
+        .collect_frames()
+        .unwrap();
+    assert_eq!(frames.len(), 6);
+    assert_ne!(frames[0].buffer(), frames[1].buffer(), "the views turn");
+    ok(&kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "--size",
+        "20x20",
+        "--orbit",
+        "3",
+        "-o",
+        &dir.s("spin.apng"),
+    ]));
+    let png = image::codecs::png::PngDecoder::new(std::io::BufReader::new(
+        std::fs::File::open(dir.path("spin.apng")).unwrap(),
+    ))
+    .unwrap();
+    let frames = png.apng().unwrap().into_frames().collect_frames().unwrap();
+    assert_eq!(frames.len(), 3);
+    assert_eq!(dir.files(), ["spin.apng", "spin.gif"]);
+}
+
+#[test]
+fn thumbnail_is_square_framed_and_transparent() {
+    let dir = TempDir::new("thumb");
+    std::fs::write(
+        dir.path("t.obj"),
+        "v 0 0 0\nv 4 0 0\nv 0 2 0\nv 4 2 0\nf 1 2 4\nf 1 4 3\n",
+    )
+    .unwrap();
+    let o = kantele(&[
+        "thumbnail",
+        &dir.s("t.obj"),
+        &dir.s("t.png"),
+        "--size",
+        "64",
+    ]);
+    ok(&o);
+    let img = image::open(dir.path("t.png")).unwrap().to_rgba8();
+    assert_eq!(img.dimensions(), (64, 64));
+    assert_eq!(img.get_pixel(0, 0).0[3], 0, "transparent corner");
+    assert_eq!(img.get_pixel(32, 32).0[3], 255, "the model in the middle");
+    assert_eq!(
+        dir.files(),
+        ["t.obj", "t.png"],
+        "no sidecar, no temporaries"
+    );
+    let entry = include_str!("../data/kantele.thumbnailer");
+    assert!(entry.contains("Exec=kantele thumbnail %i %o --size %s"));
+}
