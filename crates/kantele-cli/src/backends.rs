@@ -14,6 +14,7 @@ pub fn make_backend(kind: BackendKind, cpu: &CpuArgs, fast: bool) -> Result<Box<
             let options = CpuOptions {
                 threads: cpu.threads,
                 strategy: cpu.strategy.unwrap_or_default(),
+                timeout: cpu.timeout,
                 ..CpuOptions::default()
             };
             let backend = CpuBackend::new(options).map_err(|e| anyhow!("cpu backend: {e}"))?;

@@ -166,6 +166,23 @@ pub struct CpuArgs {
     /// CPU triangle traversal strategy: bbox, incremental, block, adaptive, bisector.
     #[arg(long, value_name = "NAME", value_parser = parse_strategy)]
     pub strategy: Option<Strategy>,
+    /// Longest a CPU frame may take, in seconds; a frame that runs longer stops cleanly with an
+    /// error (a work budget for untrusted scenes).
+    #[arg(long, value_name = "SECONDS", value_parser = parse_timeout)]
+    pub timeout: Option<std::time::Duration>,
+}
+
+/// Parses `--timeout`: positive seconds (fractions allowed).
+fn parse_timeout(s: &str) -> Result<std::time::Duration, String> {
+    let seconds: f64 = s
+        .parse()
+        .map_err(|_| format!("'{s}' is not a number of seconds"))?;
+    if !(seconds > 0.0 && seconds <= 1e9) {
+        return Err(format!(
+            "'{s}': the timeout must be a positive number of seconds"
+        ));
+    }
+    Ok(std::time::Duration::from_secs_f64(seconds))
 }
 
 /// `kantele render`.

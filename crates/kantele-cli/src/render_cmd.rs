@@ -161,8 +161,13 @@ pub fn render_pass(
     label: &str,
 ) -> Result<(FrameImage, f64)> {
     let start = Instant::now();
-    backend.render(view).map_err(|e| anyhow!("{label}: {e}"))?;
+    let stats = backend.render(view).map_err(|e| anyhow!("{label}: {e}"))?;
     let ms = start.elapsed().as_secs_f64() * 1000.0;
+    if view.pass == kantele::backend::Pass::Color {
+        if let Some(warning) = stats.empty_picture_warning() {
+            eprintln!("kantele: warning: {label}: {warning}");
+        }
+    }
     let frame = backend.read_frame().map_err(|e| anyhow!("{label}: {e}"))?;
     let n = view.width as usize * view.height as usize;
     if (frame.width, frame.height) != (view.width, view.height)

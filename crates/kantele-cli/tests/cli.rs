@@ -848,3 +848,45 @@ fn patched_reference_files_bad_indices_and_nan_positions() {
     let img = image::open(dir.path("nan.png")).expect("png").to_rgba8();
     assert_eq!(img.dimensions(), (192, 192));
 }
+
+#[test]
+fn a_frame_over_its_time_budget_fails_cleanly() {
+    let dir = TempDir::new("timeout");
+    let out = dir.s("teapot.png");
+    // A budget far below one frame: the frame stops at its first check, nothing is written.
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "teapot",
+        "-o",
+        &out,
+        "--size",
+        "640x480",
+        "--timeout",
+        "0.000001",
+    ]);
+    assert_clean_failure(&o, "time budget", &dir, &[]);
+    // A generous budget renders as usual.
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "teapot",
+        "-o",
+        &out,
+        "--timeout",
+        "60",
+    ]);
+    ok(&o);
+    // A budget that is not a positive number is a usage error.
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "teapot",
+        "-o",
+        &out,
+        "--timeout",
+        "0",
+    ]);
+    assert!(!o.status.success());
+    assert!(stderr(&o).contains("timeout"), "{}", stderr(&o));
+}
