@@ -3,6 +3,7 @@
 
 use anyhow::{anyhow, bail, Result};
 use glam::Vec3;
+use kantele::scene::NamedCamera;
 use kantele_io::pose::sidecar::{read_views_file, ViewDefaults};
 use kantele_io::pose::{Bounds, CameraPose, UpAxis};
 use kantele_io::LoadedScene;
@@ -206,27 +207,38 @@ impl CameraPlan {
         }
         let file_camera =
             || CameraPose::from_scene_camera(&loaded.scene.camera, width, height).map_err(pose_err);
+        let cameras = file_cameras(loaded);
+        let numbered_camera = |index: usize, asked: &str| -> Result<CameraPose> {
+            let chosen = cameras.get(index).ok_or_else(|| {
+                if cameras.is_empty() {
+                    anyhow!(
+                        "{label}: --camera {asked}: the file has no camera (use auto or look-at)"
+                    )
+                } else {
+                    anyhow!(
+                        "{label}: --camera {asked}: the file has {} camera(s): {}",
+                        cameras.len(),
+                        camera_list(loaded)
+                    )
+                }
+            })?;
+            CameraPose::from_scene_camera(&chosen.camera, width, height).map_err(pose_err)
+        };
         let pose = match &self.spec {
             None if loaded.info.camera_from_file => file_camera()?,
             None | Some(CameraSpec::Auto) => self.auto(&bounds()?, width, height, label)?,
-            Some(CameraSpec::FileIndex(i)) => {
-                self.check_file_camera(loaded, label, *i, &i.to_string())?;
-                file_camera()?
-            }
+            Some(CameraSpec::FileIndex(i)) => numbered_camera(*i, &i.to_string())?,
             Some(CameraSpec::FileName(name)) => {
-                let i = loaded
-                    .info
-                    .cameras
+                let i = cameras
                     .iter()
-                    .position(|c| c == name)
+                    .position(|c| &c.name == name)
                     .ok_or_else(|| {
                         anyhow!(
                             "{label}: no camera named '{name}' (cameras: {})",
                             camera_list(loaded)
                         )
                     })?;
-                self.check_file_camera(loaded, label, i, name)?;
-                file_camera()?
+                numbered_camera(i, name)?
             }
             Some(CameraSpec::LookAt { eye, target, up }) => {
                 let up = up.unwrap_or(self.up.vector().as_vec3());
@@ -251,46 +263,31 @@ impl CameraPlan {
         CameraPose::frame_bounds(bounds, dir.as_vec3(), self.up, self.yfov, width, height)
             .map_err(|e| anyhow!("{label}: camera: {}", e.0))
     }
+}
 
-    /// The loader keeps the file's first camera (the one the reference rules pick); others are
-    /// refused by name rather than silently replaced.
-    fn check_file_camera(
-        &self,
-        loaded: &LoadedScene,
-        label: &str,
-        index: usize,
-        asked: &str,
-    ) -> Result<()> {
-        if !loaded.info.camera_from_file || loaded.info.cameras.is_empty() {
-            bail!("{label}: --camera {asked}: the file has no camera (use auto or look-at)");
-        }
-        if index >= loaded.info.cameras.len() {
-            bail!(
-                "{label}: --camera {asked}: the file has {} camera(s): {}",
-                loaded.info.cameras.len(),
-                camera_list(loaded)
-            );
-        }
-        if index != 0 {
-            bail!(
-                "{label}: --camera {asked}: only the file's first camera ({}) can be used yet",
-                loaded.info.cameras[0]
-            );
-        }
-        Ok(())
+/// The file's usable cameras, numbered as `--camera N` takes them: the loader's list, or the
+/// scene's own camera when a source (a built-in scene) has one but lists none.
+fn file_cameras(loaded: &LoadedScene) -> Vec<NamedCamera> {
+    if loaded.scene.file_cameras.is_empty() && loaded.info.camera_from_file {
+        vec![NamedCamera {
+            name: "camera".into(),
+            camera: loaded.scene.camera,
+        }]
+    } else {
+        loaded.scene.file_cameras.clone()
     }
 }
 
+/// The file's usable cameras, numbered, for messages.
 fn camera_list(loaded: &LoadedScene) -> String {
-    if loaded.info.cameras.is_empty() {
+    let cameras = file_cameras(loaded);
+    if cameras.is_empty() {
         return "none".into();
     }
-    loaded
-        .info
-        .cameras
+    cameras
         .iter()
         .enumerate()
-        .map(|(i, c)| format!("{i} '{c}'"))
+        .map(|(i, c)| format!("{i} '{}'", c.name))
         .collect::<Vec<_>>()
         .join(", ")
 }
@@ -389,6 +386,46 @@ mod tests {
         )
         .unwrap();
         assert!(missing.poses(&loaded, 64, 48, "cube").is_err());
+    }
+
+    #[test]
+    fn every_file_camera_by_index_and_name() {
+        let mut loaded = cube();
+        let first = loaded.scene.camera;
+        let second = kantele::scene::Camera {
+            view: kantele::camera::look_at(Vec3::new(3.0, 2.0, 1.0), Vec3::ZERO, Vec3::Y),
+            ..first
+        };
+        loaded.scene.file_cameras = vec![
+            NamedCamera {
+                name: "front".into(),
+                camera: first,
+            },
+            NamedCamera {
+                name: "side".into(),
+                camera: second,
+            },
+        ];
+        let pose = |camera: &str| {
+            let plan = CameraPlan::new(
+                &CameraArgs {
+                    camera: Some(camera.into()),
+                    ..Default::default()
+                },
+                None,
+            )
+            .unwrap();
+            plan.poses(&loaded, 64, 48, "cube").map(|p| p[0].view())
+        };
+        let expected = CameraPose::from_scene_camera(&second, 64, 48)
+            .unwrap()
+            .view();
+        assert_eq!(pose("1").unwrap(), expected);
+        assert_eq!(pose("side").unwrap(), expected);
+        assert_ne!(pose("0").unwrap(), expected);
+        let err = pose("top").unwrap_err().to_string();
+        assert!(err.contains("0 'front', 1 'side'"), "{err}");
+        assert!(pose("2").is_err());
     }
 
     #[test]

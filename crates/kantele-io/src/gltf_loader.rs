@@ -7,7 +7,9 @@ use std::sync::Arc;
 use glam::{Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
-use kantele::scene::{AlphaMode, Camera, Draw, Light, Material, Mesh, Scene, TextureBinding};
+use kantele::scene::{
+    AlphaMode, Camera, Draw, Light, Material, Mesh, NamedCamera, Scene, TextureBinding,
+};
 use kantele::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 
 use crate::accessor::{read_f32, read_u32, BufferData};
@@ -353,8 +355,17 @@ impl Loader<'_> {
             }
             let local = Mat4::from_cols_array_2d(&node.transform().matrix());
             let world = parent * local;
-            if camera.is_none() {
-                camera = self.camera(&node, world);
+            if let Some(c) = self.camera(&node, world) {
+                let name = node
+                    .camera()
+                    .map(|c| named(c.name(), "camera", c.index()))
+                    .unwrap_or_default();
+                self.scene
+                    .file_cameras
+                    .push(NamedCamera { name, camera: c });
+                if camera.is_none() {
+                    camera = Some(c);
+                }
             }
             if let Some(l) = node.light() {
                 match l.kind() {

@@ -166,6 +166,15 @@ impl Draw {
     }
 }
 
+/// A camera of the source file with its name (the glTF camera's name, or `camera N`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct NamedCamera {
+    /// The camera's name in the file.
+    pub name: String,
+    /// The camera, placed by its node.
+    pub camera: Camera,
+}
+
 /// A perspective camera: placement plus glTF-style projection parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
@@ -268,6 +277,9 @@ pub struct Scene {
     pub draws: Vec<Draw>,
     /// The scene's camera (a loader supplies a framing one when the file has none).
     pub camera: Camera,
+    /// Every usable camera of the source file, in draw order, by name (the first is `camera`);
+    /// empty when the file has none.
+    pub file_cameras: Vec<NamedCamera>,
     /// The light.
     pub light: Light,
     /// Ambient term of the Lambert rule.
@@ -286,6 +298,7 @@ impl Default for Scene {
             textures: Vec::new(),
             draws: Vec::new(),
             camera: Camera::framing(Vec3::ZERO, 1.0, Vec3::Z, 4.0 / 3.0),
+            file_cameras: Vec::new(),
             light: Light::Headlight,
             ambient: 0.1,
             clear_color: Vec4::new(0.0, 0.0, 0.0, 1.0),

@@ -106,6 +106,7 @@ pub fn scene() -> (Scene, SceneInfo) {
             node_index: 1,
         }],
         camera: thesis_camera(view),
+        file_cameras: Vec::new(),
         light: Light::Headlight,
         ambient: 0.1,
         clear_color: CLEAR_COLOR,

@@ -95,6 +95,7 @@ pub fn scene() -> (Scene, SceneInfo) {
     };
     let eye = Vec3::new(0.0, 1.5, 0.0);
     let scene = Scene {
+        file_cameras: Vec::new(),
         meshes: vec![ground_mesh(0), cube, triangle_mesh(2)],
         materials,
         textures: vec![Arc::new(texture)],

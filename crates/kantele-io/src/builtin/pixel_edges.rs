@@ -59,6 +59,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         material: 0,
     };
     let scene = Scene {
+        file_cameras: Vec::new(),
         meshes: vec![mesh],
         materials: vec![Material {
             name: "unlit vertex colour".into(),
