@@ -411,8 +411,12 @@ fn kernel_matrices_and_vertex_transform_match_glam() {
     assert_eq!(device.lines().count(), 2000);
 }
 
+/// Texture sampling: the kernels filter linear `f32` texels decoded at upload from the core's
+/// RGBA8 levels, the core's scalar sampler decodes as it fetches; the two may round the last
+/// bit differently (issue 8 allows texture filtering to round differently), so each channel must
+/// agree within 4e-6 — far below one 8-bit level (3.9e-3).
 #[test]
-fn kernel_texture_sampling_matches_the_core_bit_for_bit() {
+fn kernel_texture_sampling_matches_the_core() {
     let Some(harness) = build_harness() else {
         return;
     };
@@ -484,8 +488,19 @@ fn kernel_texture_sampling_matches_the_core_bit_for_bit() {
         expected.push('\n');
     }
     let device = run_harness(&harness, input);
+    let values = |line: &str| -> Vec<f32> {
+        line.split_whitespace()
+            .skip(1)
+            .map(|h| f32::from_bits(u32::from_str_radix(h, 16).expect("hex float")))
+            .collect()
+    };
     for (i, (d, e)) in device.lines().zip(expected.lines()).enumerate() {
-        assert_eq!(d, e, "case {i}");
+        let (d, e) = (values(d), values(e));
+        assert_eq!(d.len(), e.len(), "case {i}");
+        for (a, b) in d.iter().zip(&e) {
+            let close = a == b || (a.is_nan() && b.is_nan()) || (a - b).abs() <= 4e-6;
+            assert!(close, "case {i}: kernel {d:?}, core {e:?}");
+        }
     }
     assert_eq!(device.lines().count(), cases);
 }
