@@ -302,19 +302,19 @@ struct ClipPolygon {
     int len;
 };
 
-__device__ __forceinline__ double dmul(double a, double b) { return __dmul_rn(a, b); }
-__device__ __forceinline__ double dadd(double a, double b) { return __dadd_rn(a, b); }
-__device__ __forceinline__ double dsub(double a, double b) { return __dsub_rn(a, b); }
-__device__ __forceinline__ double ddiv(double a, double b) { return __ddiv_rn(a, b); }
+__device__ __forceinline__ double kd_mul(double a, double b) { return __dmul_rn(a, b); }
+__device__ __forceinline__ double kd_add(double a, double b) { return __dadd_rn(a, b); }
+__device__ __forceinline__ double kd_sub(double a, double b) { return __dsub_rn(a, b); }
+__device__ __forceinline__ double kd_div(double a, double b) { return __ddiv_rn(a, b); }
 
 // The polygon's `w` plane lies at 2^-40 · (largest w), or KANTELE_W_EPSILON (`W_MIN`) if larger.
 #define KANTELE_W_RELATIVE_EPSILON (1.0 / 1099511627776.0)
 
 // `dot(plane, p) − offset` in double, as glam's `DVec4::dot` (x, y, z, w in order).
 __device__ __forceinline__ double clip_distance(D4 plane, double offset, D4 p) {
-    double d = dadd(dadd(dadd(dmul(plane.x, p.x), dmul(plane.y, p.y)), dmul(plane.z, p.z)),
-                    dmul(plane.w, p.w));
-    return dsub(d, offset);
+    double d = kd_add(kd_add(kd_add(kd_mul(plane.x, p.x), kd_mul(plane.y, p.y)), kd_mul(plane.z, p.z)),
+                    kd_mul(plane.w, p.w));
+    return kd_sub(d, offset);
 }
 
 // `ClipPolygon::clip_plane`: Sutherland–Hodgman against one plane, in double, interpolating
@@ -351,21 +351,21 @@ __device__ void clip_plane(ClipPolygon& poly, D4 plane, double offset) {
             const int outer = da >= 0.0 ? j : i;
             double d_in = da >= 0.0 ? da : db;
             double d_out = da >= 0.0 ? db : da;
-            double t = ddiv(d_in, dsub(d_in, d_out));
+            double t = kd_div(d_in, kd_sub(d_in, d_out));
             ClipVertex v = src[inner];
             for (int k = 0; k < NV; ++k) {
                 double a = (double)src[inner].varyings[k];
                 double b = (double)src[outer].varyings[k];
-                v.varyings[k] = (float)dadd(a, dmul(dsub(b, a), t));
+                v.varyings[k] = (float)kd_add(a, kd_mul(kd_sub(b, a), t));
             }
             const D4 pi = src_p[inner];
             const D4 po = src_p[outer];
             if (out < KANTELE_MAX_CLIPPED_VERTICES) {
                 poly.v[out] = v;
-                poly.p[out] = {dadd(pi.x, dmul(dsub(po.x, pi.x), t)),
-                               dadd(pi.y, dmul(dsub(po.y, pi.y), t)),
-                               dadd(pi.z, dmul(dsub(po.z, pi.z), t)),
-                               dadd(pi.w, dmul(dsub(po.w, pi.w), t))};
+                poly.p[out] = {kd_add(pi.x, kd_mul(kd_sub(po.x, pi.x), t)),
+                               kd_add(pi.y, kd_mul(kd_sub(po.y, pi.y), t)),
+                               kd_add(pi.z, kd_mul(kd_sub(po.z, pi.z), t)),
+                               kd_add(pi.w, kd_mul(kd_sub(po.w, pi.w), t))};
                 out += 1;
             }
         }
@@ -384,7 +384,7 @@ __device__ void clip_polygon(ClipPolygon& poly, float kx, float ky) {
     clip_plane(poly, {0.0, 0.0, 1.0, 1.0}, 0.0);
     double w_max = 0.0;
     for (int i = 0; i < poly.len; ++i) w_max = fmax(w_max, poly.p[i].w);
-    double w_floor = fmax(dmul(KANTELE_W_RELATIVE_EPSILON, w_max), (double)KANTELE_W_EPSILON);
+    double w_floor = fmax(kd_mul(KANTELE_W_RELATIVE_EPSILON, w_max), (double)KANTELE_W_EPSILON);
     clip_plane(poly, {0.0, 0.0, 0.0, 1.0}, w_floor);
     const double dkx = (double)kx, dky = (double)ky;
     clip_plane(poly, {-1.0, 0.0, 0.0, dkx}, 0.0);
