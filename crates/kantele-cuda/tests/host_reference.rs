@@ -29,7 +29,18 @@ fn required() -> bool {
         .unwrap_or(false)
 }
 
+/// The harness, compiled once for all tests of this file (tests run in parallel threads: each
+/// compiling to the same path would replace the executable while another test runs it).
 fn build_harness() -> Option<PathBuf> {
+    static HARNESS: std::sync::OnceLock<Result<Option<PathBuf>, String>> =
+        std::sync::OnceLock::new();
+    match HARNESS.get_or_init(compile_harness) {
+        Ok(path) => path.clone(),
+        Err(message) => panic!("{message}"),
+    }
+}
+
+fn compile_harness() -> Result<Option<PathBuf>, String> {
     let cxx = std::env::var("CXX").unwrap_or_else(|_| "c++".into());
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/host");
     let out = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("kantele-cuda-host-harness");
@@ -47,15 +58,15 @@ fn build_harness() -> Option<PathBuf> {
         .arg(&out)
         .output();
     match result {
-        Ok(o) if o.status.success() => Some(out),
-        Ok(o) => panic!(
+        Ok(o) if o.status.success() => Ok(Some(out)),
+        Ok(o) => Err(format!(
             "the kernels' common.cuh does not compile as host C++:\n{}",
             String::from_utf8_lossy(&o.stderr)
-        ),
-        Err(e) if required() => panic!("KANTELE_REQUIRE=cxx but {cxx} cannot run: {e}"),
+        )),
+        Err(e) if required() => Err(format!("KANTELE_REQUIRE=cxx but {cxx} cannot run: {e}")),
         Err(e) => {
             eprintln!("skipping: no C++ compiler ({cxx}: {e})");
-            None
+            Ok(None)
         }
     }
 }
