@@ -1,5 +1,5 @@
 """The Python package against the `kantele` command, same scenes and views: colour byte for
-byte, depth (eye distance, PFM) and ids (16-bit PNG) exactly, normals within the PNG's
+byte, depth (eye distance, PFM) and instance ids (16-bit PNG) exactly, normals within the PNG's
 8-bit quantisation."""
 
 import subprocess
@@ -40,9 +40,12 @@ def check_same(expected_dir, stem, frame, out):
     np.testing.assert_array_equal(out["color"], read_png(f"{base}.png"),
                                   err_msg=f"{stem} view {frame}: colour differs from the CLI")
     np.testing.assert_array_equal(out["depth"], read_pfm(f"{base}.pfm"))
+    # `--ids FILE` writes the instance ids as one 16-bit channel (0 = background): the first of
+    # the package's (instance, primitive, draw) channels.
     ids = read_png(f"{base}_ids.png")
     assert ids.dtype == np.uint16
-    np.testing.assert_array_equal(out["ids"], ids.astype(np.uint32))
+    instance = ids.reshape(out["ids"].shape[:2]).astype(np.uint32)
+    np.testing.assert_array_equal(out["ids"][..., 0], instance)
     normals_png = read_png(f"{base}_n.png")
     covered = normals_png[..., 3] == 255
     assert covered.any()
