@@ -141,15 +141,7 @@ impl<'a> MaterialShader<'a> {
         let color = Vec4::new(v[5], v[6], v[7], v[8]);
         let mut base = self.material.base_color_factor * color;
         if let Some((texture, sampler)) = self.texture {
-            let uv = Vec2::new(v[3], v[4]);
-            let (du_dx, du_dy) = fragment.derivatives(3);
-            let (dv_dx, dv_dy) = fragment.derivatives(4);
-            base *= texture.sample_grad(
-                &sampler,
-                uv,
-                Vec2::new(du_dx, dv_dx),
-                Vec2::new(du_dy, dv_dy),
-            );
+            base *= sample(fragment, texture, &sampler);
         }
         base
     }
@@ -225,16 +217,7 @@ impl MaterialShader<'_> {
     fn emissive(&self, fragment: &Fragment<'_>) -> Vec3 {
         let mut emissive = self.material.emissive;
         if let Some((texture, sampler)) = self.emissive_texture {
-            let v = fragment.varyings();
-            let (du_dx, du_dy) = fragment.derivatives(3);
-            let (dv_dx, dv_dy) = fragment.derivatives(4);
-            let sample = texture.sample_grad(
-                &sampler,
-                Vec2::new(v[3], v[4]),
-                Vec2::new(du_dx, dv_dx),
-                Vec2::new(du_dy, dv_dy),
-            );
-            emissive *= sample.truncate();
+            emissive *= sample(fragment, texture, &sampler).truncate();
         }
         emissive
     }
@@ -325,15 +308,7 @@ impl MaterialShader<'_> {
             lanes.splat_f32(e.z),
         ];
         if let Some((texture, sampler)) = self.emissive_texture {
-            let (du_dx, du_dy) = f.derivatives(3);
-            let (dv_dx, dv_dy) = f.derivatives(4);
-            let texel = texture.sample_grad_lanes::<L>(
-                &sampler,
-                [f.varying(3), f.varying(4)],
-                [du_dx, dv_dx],
-                [du_dy, dv_dy],
-                f.active,
-            );
+            let texel = sample_lanes(f, texture, &sampler);
             for c in 0..3 {
                 emissive[c] = emissive[c] * texel[c];
             }
@@ -353,15 +328,7 @@ impl MaterialShader<'_> {
             lanes.splat_f32(factor[3]) * f.varying(8),
         ];
         if let Some((texture, sampler)) = self.texture {
-            let (du_dx, du_dy) = f.derivatives(3);
-            let (dv_dx, dv_dy) = f.derivatives(4);
-            let texel = texture.sample_grad_lanes::<L>(
-                &sampler,
-                [f.varying(3), f.varying(4)],
-                [du_dx, dv_dx],
-                [du_dy, dv_dy],
-                f.active,
-            );
+            let texel = sample_lanes(f, texture, &sampler);
             for c in 0..4 {
                 base[c] = base[c] * texel[c];
             }
@@ -411,4 +378,37 @@ impl MaterialShader<'_> {
             ],
         }
     }
+}
+
+/// A texture sampled at the material's texture coordinates (varyings 3 and 4) with their
+/// analytic screen-space derivatives, lane-wide.
+#[inline(always)]
+fn sample_lanes<L: Lanes>(
+    f: &FragmentLanes<'_, L>,
+    texture: &Texture,
+    sampler: &Sampler,
+) -> [L::F32; 4] {
+    let (du_dx, du_dy) = f.derivatives(3);
+    let (dv_dx, dv_dy) = f.derivatives(4);
+    texture.sample_grad_lanes::<L>(
+        sampler,
+        [f.varying(3), f.varying(4)],
+        [du_dx, dv_dx],
+        [du_dy, dv_dy],
+        f.active,
+    )
+}
+
+/// [`sample_lanes`] for one fragment.
+#[inline]
+fn sample(fragment: &Fragment<'_>, texture: &Texture, sampler: &Sampler) -> Vec4 {
+    let v = fragment.varyings();
+    let (du_dx, du_dy) = fragment.derivatives(3);
+    let (dv_dx, dv_dy) = fragment.derivatives(4);
+    texture.sample_grad(
+        sampler,
+        Vec2::new(v[3], v[4]),
+        Vec2::new(du_dx, dv_dx),
+        Vec2::new(du_dy, dv_dy),
+    )
 }
