@@ -2,56 +2,13 @@
 //! `--orbit`), one-channel id files, BOP depth, standard output, and whole output sets
 //! (inputs protected, Ctrl-C leaves nothing behind).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-const BIN: &str = env!("CARGO_BIN_EXE_kantele");
+mod common;
 
-/// A fresh directory removed on drop.
-struct TempDir(PathBuf);
-
-impl TempDir {
-    fn new(tag: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("kantele-data-{tag}-{}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        TempDir(dir)
-    }
-    fn path(&self, name: &str) -> PathBuf {
-        self.0.join(name)
-    }
-    fn s(&self, name: &str) -> String {
-        self.path(name).to_string_lossy().into_owned()
-    }
-    fn files(&self) -> Vec<String> {
-        let mut v: Vec<String> = std::fs::read_dir(&self.0)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .collect();
-        v.sort();
-        v
-    }
-}
-
-impl Drop for TempDir {
-    fn drop(&mut self) {
-        let _ = std::fs::remove_dir_all(&self.0);
-    }
-}
-
-fn kantele(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().expect("run kantele")
-}
-
-fn ok(o: &Output) {
-    assert!(
-        o.status.success(),
-        "kantele failed ({:?}):\n{}",
-        o.status,
-        String::from_utf8_lossy(&o.stderr)
-    );
-}
+use common::{kantele, ok, TempDir, BIN};
 
 fn err_line(o: &Output) -> String {
     assert!(!o.status.success(), "expected a failure");
