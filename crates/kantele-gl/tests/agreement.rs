@@ -4,48 +4,12 @@
 //! as 8-bit sRGB. Skips (with a message) when EGL/OpenGL or the scenes are unavailable.
 
 use std::path::{Path, PathBuf};
-use std::sync::Arc;
 
-use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::compare::{compare, edge_mask, Comparison};
-use kantele::cpu::{CpuBackend, CpuOptions};
-use kantele::scene::Scene;
-use kantele_gl::GlBackend;
 
-fn render(backend: &mut dyn Backend, view: &FrameView) -> FrameImage {
-    backend.render(view).expect("render");
-    backend.read_frame().expect("read")
-}
+mod common;
 
-/// The OpenGL backend, or `None` (with a message) where EGL/OpenGL is unavailable.
-fn gl_or_skip() -> Option<GlBackend> {
-    match GlBackend::new() {
-        Ok(gl) => Some(gl),
-        Err(e) => {
-            kantele_testkit::skip("gl", format!("OpenGL unavailable: {e}"));
-            None
-        }
-    }
-}
-
-/// Renders a scene with both backends; returns (cpu, gl, cpu ids).
-fn render_both(scene: Scene, gl: &mut GlBackend) -> (FrameImage, FrameImage, FrameImage) {
-    let scene = Arc::new(scene);
-    let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu");
-    cpu.load(scene.clone()).expect("cpu load");
-    gl.load(scene.clone()).expect("gl load");
-    let view = FrameView::of_scene(&scene);
-    let a = render(&mut cpu, &view);
-    let b = render(gl, &view);
-    let ids = render(
-        &mut cpu,
-        &FrameView {
-            pass: Pass::Ids,
-            ..view
-        },
-    );
-    (a, b, ids)
-}
+use common::{gl_or_skip, render_both};
 
 #[test]
 fn builtin_scenes_agree_with_opengl() {

@@ -7,34 +7,18 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3, Vec4};
-use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::compare::{compare, edge_mask};
-use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::scene::{AlphaMode, Camera, Draw, Material, Mesh, Scene, TextureBinding};
 use kantele::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
 use kantele_gl::GlBackend;
 
-fn render(backend: &mut dyn Backend, view: &FrameView) -> FrameImage {
-    backend.render(view).expect("render");
-    backend.read_frame().expect("read")
-}
+mod common;
+
+use common::{gl_or_skip, render_both};
 
 /// Renders with both backends and checks agreement (the reference-scene tolerances).
 fn assert_agree(name: &str, scene: Scene, gl: &mut GlBackend) {
-    let scene = Arc::new(scene);
-    let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu");
-    cpu.load(scene.clone()).expect("cpu load");
-    gl.load(scene.clone()).expect("gl load");
-    let view = FrameView::of_scene(&scene);
-    let a = render(&mut cpu, &view);
-    let b = render(gl, &view);
-    let ids = render(
-        &mut cpu,
-        &FrameView {
-            pass: Pass::Ids,
-            ..view
-        },
-    );
+    let (a, b, ids) = render_both(scene, gl);
     let c = compare(&a, &b, Some(&edge_mask(&ids)), 3).expect("same size");
     eprintln!(
         "{name:28} coverage {:.4}%  mean {:.3}  max {:3}  interior>3: {}",
@@ -85,12 +69,8 @@ fn draw(mesh: usize, model: Mat4) -> Draw {
 
 #[test]
 fn blend_order_and_emission_agree_with_opengl() {
-    let mut gl = match GlBackend::new() {
-        Ok(gl) => gl,
-        Err(e) => {
-            eprintln!("skipping: OpenGL unavailable: {e}");
-            return;
-        }
+    let Some(mut gl) = gl_or_skip() else {
+        return;
     };
     // A 4 × 4 checker as the emissive texture.
     let texels: Vec<u8> = (0..16)
