@@ -26,14 +26,20 @@ pub enum Rows<'a> {
     F32(&'a [f32]),
 }
 
-impl Rows<'_> {
-    fn len(&self) -> usize {
+impl<'a> Rows<'a> {
+    /// Number of values.
+    pub fn len(&self) -> usize {
         match self {
             Rows::U8(v) => v.len(),
             Rows::U16(v) => v.len(),
             Rows::U32(v) => v.len(),
             Rows::F32(v) => v.len(),
         }
+    }
+
+    /// Whether there are no values.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
     }
 
     fn kind(&self) -> SampleKind {

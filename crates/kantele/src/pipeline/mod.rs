@@ -294,6 +294,11 @@ impl<'a> Frame<'_, 'a> {
         let (strategy, isa) = (*strategy, *isa);
         let budget = FrameBudget::new(start, *timeout, cancel.as_deref());
         pool.install(|| {
+            // A frame cancelled before it began (a big target takes a while to allocate)
+            // skips even the clear.
+            if budget.exhausted() {
+                return;
+            }
             framebuffer.clear(clear_color, clear_depth);
             let viewport = Viewport::new(framebuffer.width(), framebuffer.height());
             let geometry_start = Instant::now();
