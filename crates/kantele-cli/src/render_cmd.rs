@@ -15,7 +15,8 @@ use kantele::scene::Scene;
 use kantele::stats::FrameStats;
 use kantele::RenderError;
 use kantele_io::output::OutputSet;
-use kantele_io::pose::sidecar::{DrawId, InstanceId, SidecarCamera, SidecarDepth, SidecarIds};
+use kantele_io::pose::sidecar::{AnimationSidecar, DrawId, InstanceId, SidecarCamera};
+use kantele_io::pose::sidecar::{SidecarDepth, SidecarIds};
 use kantele_io::pose::sidecar::{SidecarNormals, MATRIX_LAYOUT};
 use kantele_io::pose::{rows, CameraPose, Sidecar};
 use serde_json::json;
@@ -129,14 +130,11 @@ fn plan_outputs(
             } else {
                 Some(expand(&args.output)?)
             };
-            let sidecar = color
-                .as_ref()
-                .filter(|_| !is_animation(&args.output))
-                .map(|c| {
-                    let mut s = c.clone().into_os_string();
-                    s.push(".json");
-                    PathBuf::from(s)
-                });
+            let sidecar = color.as_ref().map(|c| {
+                let mut s = c.clone().into_os_string();
+                s.push(".json");
+                PathBuf::from(s)
+            });
             let paths = FramePaths {
                 color,
                 sidecar,
@@ -560,17 +558,48 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 continue;
             }
             let mut animation = Animation::new(width, height, args.fps);
+            let mut views = Vec::new();
+            let frame_paths = FramePaths {
+                color: Some(path.clone()),
+                ..FramePaths::default()
+            };
             for pose in &poses {
                 interrupt.check()?;
                 let view = pose.frame_view(&job.scene, Pass::Color);
-                let frame = render_pass(backend.as_mut(), &view, &job.label, &interrupt)?.0;
+                let (frame, ms) = render_pass(backend.as_mut(), &view, &job.label, &interrupt)?;
                 animation
                     .push(&frame)
                     .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+                views.push(sidecar(
+                    args,
+                    &SidecarInputs {
+                        input,
+                        source: &job.source,
+                        scene: &job.scene,
+                        pose,
+                        paths: &frame_paths,
+                        backend: backend.as_ref(),
+                        ms,
+                    },
+                ));
                 progress.inc(1);
             }
             interrupt.check()?;
-            animation.write(path)?;
+            let mut set = OutputSet::new();
+            animation.write(&mut set, path)?;
+            let meta = AnimationSidecar {
+                scene: input.stem(),
+                source: job.source.clone(),
+                output: path.display().to_string(),
+                fps: args.fps,
+                frames: views.len(),
+                views,
+            };
+            if let Some(p) = &outs[0].sidecar {
+                files::write_json(&mut set, p, &meta)?;
+            }
+            interrupt.check()?;
+            set.commit()?;
             continue;
         }
         for (pose, paths) in poses.iter().zip(outs) {

@@ -70,6 +70,24 @@ pub struct Sidecar {
     pub ids: SidecarIds,
 }
 
+/// The sidecar of an animation (a turntable, `--orbit N -o spin.gif`): one [`Sidecar`] per
+/// frame, frame `k` at `views[k]`. As a views file (`--views`) it renders every frame again.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AnimationSidecar {
+    /// The scene's file stem or built-in name.
+    pub scene: String,
+    /// Where the scene came from (path or `builtin:NAME`).
+    pub source: String,
+    /// The animation's path.
+    pub output: String,
+    /// Frames per second.
+    pub fps: u16,
+    /// Number of frames (`views.len()`).
+    pub frames: usize,
+    /// Each frame's view, in frame order.
+    pub views: Vec<Sidecar>,
+}
+
 /// The kind of projection a sidecar camera has.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
