@@ -15,7 +15,7 @@ use kantele::scene::Scene;
 use kantele::stats::FrameStats;
 use kantele::RenderError;
 use kantele_io::output::OutputSet;
-use kantele_io::pose::sidecar::{AnimationSidecar, DrawId, InstanceId, SidecarCamera};
+use kantele_io::pose::sidecar::{AnimationSidecar, InstanceId, PrimitiveId, SidecarCamera};
 use kantele_io::pose::sidecar::{SidecarDepth, SidecarIds};
 use kantele_io::pose::sidecar::{SidecarNormals, MATRIX_LAYOUT};
 use kantele_io::pose::{rows, CameraPose, Sidecar};
@@ -36,7 +36,7 @@ use crate::signals::InterruptFlag;
 pub const STDOUT: &str = "-";
 
 /// What the id files hold, for the sidecar.
-const ID_FILES: &str = "one channel per file (see files), 0 = background: instance = node_index + 1, mesh = mesh index + 1, material = material index + 1, primitive = draw id (draw index + 1), triangle = triangle index in its draw + 1";
+const ID_FILES: &str = "one channel per file (see files), 0 = background: instance = node_index + 1, mesh = mesh index + 1, material = material index + 1, primitive = a mesh primitive placed by a node (one draw; see primitive_ids), triangle = triangle index in its primitive + 1";
 
 /// The unit of eye and ray depth: `--depth-unit`, else millimetres for PNG and metres otherwise.
 fn depth_unit(args: &RenderArgs) -> DepthUnit {
@@ -288,11 +288,11 @@ fn sidecar(args: &RenderArgs, s: &SidecarInputs<'_>) -> Sidecar {
             node_name,
         })
         .collect();
-    let draw_ids = scene
+    let primitive_ids = scene
         .draws
         .iter()
         .enumerate()
-        .map(|(i, d)| DrawId {
+        .map(|(i, d)| PrimitiveId {
             id: i + 1,
             mesh_index: d.mesh,
             mesh_name: scene
@@ -341,7 +341,7 @@ fn sidecar(args: &RenderArgs, s: &SidecarInputs<'_>) -> Sidecar {
                 .map(|(k, p)| (k.name().to_string(), path(p)))
                 .collect(),
             instance_ids,
-            draw_ids,
+            primitive_ids,
         },
     }
 }

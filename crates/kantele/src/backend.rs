@@ -23,8 +23,9 @@ pub enum Pass {
     /// World-space unit normals (after two-sided flipping) in RGB, alpha 1; background is the
     /// clear value 0.
     Normals,
-    /// Exact integer ids stored in float channels: R = draw's `node_index + 1`, G = triangle
-    /// index within its mesh + 1, B = draw index + 1; background 0.
+    /// Exact integer ids stored in float channels: R = instance id (the draw's `node_index +
+    /// 1`), G = triangle id (triangle index within its mesh + 1), B = primitive id (draw index
+    /// + 1: in glTF terms a mesh primitive placed by a node); background 0.
     Ids,
 }
 
