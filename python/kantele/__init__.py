@@ -16,10 +16,17 @@ Conventions of every output (row 0 is the top row of the image):
 - ``ray_depth``: ``float32`` (H, W), distance from the camera centre, ``inf`` where nothing was
   drawn;
 - ``normals``: ``float32`` (H, W, 3), world-space unit normals, 0 where nothing was drawn;
-- ``ids``: ``uint32`` (H, W, 3): instance id (glTF node index + 1), primitive id (triangle index
-  in its mesh + 1), draw id (index into ``Scene.draws`` + 1); 0 = background.
+- ``ids``: ``uint32`` (H, W, 3), channels named by ``ID_CHANNELS``: instance id (glTF node index
+  + 1), triangle id (triangle index in its primitive + 1), primitive id (index into
+  ``Scene.primitives`` + 1); 0 = background.
+
+Id names follow glTF and are the CLI's ``--ids KIND=FILE`` kinds: a *primitive* is a mesh
+primitive placed by a node (one draw), a *triangle* is a triangle's index within it.
 """
 
 from ._kantele import MAX_SIZE, OUTPUTS, Camera, Scene, load, write_png
 
-__all__ = ["Camera", "Scene", "load", "write_png", "MAX_SIZE", "OUTPUTS"]
+#: The names of the ``ids`` output's channels, in order (the CLI's ``--ids`` kinds).
+ID_CHANNELS = ("instance", "triangle", "primitive")
+
+__all__ = ["Camera", "Scene", "load", "write_png", "MAX_SIZE", "OUTPUTS", "ID_CHANNELS"]

@@ -131,8 +131,12 @@ class Scene:
     @property
     def bounding_sphere(self) -> Optional[Tuple[Tuple[float, float, float], float]]: ...
     @property
+    def primitives(self) -> List[Dict[str, Union[int, str]]]:
+        """Per primitive (a mesh primitive placed by a node; the `ids` output's third channel):
+        id, node_index, node_name, mesh_index, mesh_name."""
+    @property
     def draws(self) -> List[Dict[str, Union[int, str]]]:
-        """Per draw: id, node_index, node_name, mesh_index, mesh_name."""
+        """Deprecated name of `primitives` (warns)."""
     def orbit_cameras(
         self,
         views: int,
@@ -160,7 +164,7 @@ class Scene:
         color uint8 (H, W, 4) sRGB; color_linear float32 (H, W, 4); depth float32 (H, W)
         distance along the view axis, inf = background; ray_depth float32 (H, W) distance from
         the camera centre; normals float32 (H, W, 3) world space,
-        0 = background; ids uint32 (H, W, 3) instance, primitive, draw; 0 = background."""
+        0 = background; ids uint32 (H, W, 3) instance, triangle, primitive (ID_CHANNELS); 0 = background."""
     def render_many(
         self,
         cameras: Sequence[Optional[Camera]],

@@ -19,8 +19,8 @@ pub enum OutputKind {
     RayDepth,
     /// `float32` H×W×3 world-space unit normals, background 0.
     Normals,
-    /// `uint32` H×W×3: instance (node index + 1), primitive (triangle index + 1), draw
-    /// (draw index + 1); 0 = background.
+    /// `uint32` H×W×3: instance (node index + 1), triangle (index in its primitive + 1),
+    /// primitive (draw index + 1); 0 = background.
     Ids,
 }
 

@@ -319,10 +319,11 @@ impl PyScene {
             .map(|(c, r)| ((c.x, c.y, c.z), r))
     }
 
-    /// One dict per draw, indexed by draw id − 1: `id`, `node_index`, `node_name`,
-    /// `mesh_index`, `mesh_name` (the meaning of the `ids` output's channels).
+    /// One dict per primitive (a glTF mesh primitive placed by a node: one draw), indexed by
+    /// primitive id − 1: `id`, `node_index`, `node_name`, `mesh_index`, `mesh_name` (the
+    /// meaning of the `ids` output's primitive channel).
     #[getter]
-    fn draws<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+    fn primitives<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
         let list = PyList::empty(py);
         for (i, d) in self.scene.draws.iter().enumerate() {
             let dict = PyDict::new(py);
@@ -341,6 +342,20 @@ impl PyScene {
         Ok(list)
     }
 
+    /// The old name of [`primitives`](Self::primitives), kept for a while: warns with a
+    /// `DeprecationWarning`.
+    #[getter]
+    fn draws<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyList>> {
+        let category = py.get_type::<pyo3::exceptions::PyDeprecationWarning>();
+        PyErr::warn(
+            py,
+            category.as_any(),
+            c"Scene.draws is renamed Scene.primitives (glTF: a mesh primitive placed by a node)",
+            1,
+        )?;
+        self.primitives(py)
+    }
+
     /// Renders one view and returns a dict of numpy arrays, one per name in `outputs`:
     ///
     /// - `color`: `uint8` (H, W, 4), sRGB-encoded RGB and alpha, row 0 at the top (the CLI's PNG);
@@ -348,8 +363,9 @@ impl PyScene {
     /// - `depth`: `float32` (H, W), distance along the camera's view axis (OpenCV z), `inf` where
     ///   nothing was drawn;
     /// - `normals`: `float32` (H, W, 3) world-space unit normals, 0 where nothing was drawn;
-    /// - `ids`: `uint32` (H, W, 3): instance (node index + 1), primitive (triangle + 1) and draw
-    ///   (draw index + 1) ids, 0 = background.
+    /// - `ids`: `uint32` (H, W, 3): instance (node index + 1), triangle (index in its primitive
+    ///   + 1) and primitive (index into `Scene.primitives` + 1) ids, 0 = background; the
+    ///   channel names are `kantele.ID_CHANNELS`.
     ///
     /// `camera=None` uses the scene's camera, `size=None` the scene's resolution. The GIL is
     /// released while rendering.

@@ -1,6 +1,6 @@
 """The Python package against the `kantele` command, same scenes and views: colour byte for
-byte, depth (eye distance, PFM) and instance ids (16-bit PNG) exactly, normals within the PNG's
-8-bit quantisation."""
+byte, depth (eye distance, PFM) and every id channel (16-bit PNG, `--ids KIND=FILE` with the
+package's channel names) exactly, normals within the PNG's 8-bit quantisation."""
 
 import subprocess
 
@@ -15,12 +15,17 @@ SCENES = ["thesis-cube-textured.glb", "spot-textured.glb", "alpha-blend.glb", "t
 SIZE = (96, 72)
 
 
+def output_args(base):
+    """The CLI's outputs for file names starting with `base`: colour, depth, normals, instance
+    ids (`--ids FILE`) and one file per id kind, named as the package names its id channels."""
+    return ["-o", f"{base}.png", "--depth", f"{base}.pfm", "--normals", f"{base}_n.png",
+            "--ids", f"{base}_ids.png",
+            *[a for kind in kantele.ID_CHANNELS for a in ("--ids", f"{kind}={base}_{kind}.png")]]
+
+
 def cli_render(cli, scene_paths, out_dir, orbit=None):
     args = [cli, "render", *map(str, scene_paths), "--size", f"{SIZE[0]}x{SIZE[1]}",
-            "-o", f"{out_dir}/{{stem}}_{{frame}}.png",
-            "--depth", f"{out_dir}/{{stem}}_{{frame}}.pfm",
-            "--normals", f"{out_dir}/{{stem}}_{{frame}}_n.png",
-            "--ids", f"{out_dir}/{{stem}}_{{frame}}_ids.png"]
+            *output_args(f"{out_dir}/{{stem}}_{{frame}}")]
     if orbit:
         args += ["--orbit", str(orbit)]
     subprocess.run(args, check=True, capture_output=True)
@@ -41,11 +46,15 @@ def check_same(expected_dir, stem, frame, out):
                                   err_msg=f"{stem} view {frame}: colour differs from the CLI")
     np.testing.assert_array_equal(out["depth"], read_pfm(f"{base}.pfm"))
     # `--ids FILE` writes the instance ids as one 16-bit channel (0 = background): the first of
-    # the package's (instance, primitive, draw) channels.
+    # the package's (instance, triangle, primitive) channels.
     ids = read_png(f"{base}_ids.png")
     assert ids.dtype == np.uint16
     instance = ids.reshape(out["ids"].shape[:2]).astype(np.uint32)
     np.testing.assert_array_equal(out["ids"][..., 0], instance)
+    # One vocabulary: the CLI's id kinds are the package's channel names, channel for channel.
+    for k, kind in enumerate(kantele.ID_CHANNELS):
+        channel = read_png(f"{base}_{kind}.png").reshape(out["ids"].shape[:2]).astype(np.uint32)
+        np.testing.assert_array_equal(out["ids"][..., k], channel, err_msg=f"{kind} ids differ")
     normals_png = read_png(f"{base}_n.png")
     covered = normals_png[..., 3] == 255
     assert covered.any()
@@ -78,7 +87,5 @@ def test_orbit_views_match_the_cli(cli, scenes_dir, tmp_path):
 
 def test_builtin_scene_matches_the_cli(cli, tmp_path):
     subprocess.run([cli, "render", "--builtin", "teapot", "--size", f"{SIZE[0]}x{SIZE[1]}",
-                    "-o", f"{tmp_path}/teapot_0.png", "--depth", f"{tmp_path}/teapot_0.pfm",
-                    "--normals", f"{tmp_path}/teapot_0_n.png",
-                    "--ids", f"{tmp_path}/teapot_0_ids.png"], check=True, capture_output=True)
+                    *output_args(f"{tmp_path}/teapot_0")], check=True, capture_output=True)
     check_same(tmp_path, "teapot", 0, kantele.Scene.builtin("teapot").render(size=SIZE))

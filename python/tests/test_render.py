@@ -43,7 +43,8 @@ def test_outputs_of_a_numpy_quad_seen_head_on():
     # World normals face +Z; background normals are 0.
     np.testing.assert_allclose(normals[covered], np.broadcast_to([0, 0, 1], normals[covered].shape), atol=1e-6)
     assert (normals[~covered] == 0).all()
-    # Ids: instance 1, draw 1, primitives 1 and 2 (the two triangles); background 0.
+    # Ids: instance 1, primitive 1 (one draw), triangles 1 and 2; background 0.
+    assert kantele.ID_CHANNELS == ("instance", "triangle", "primitive")
     assert (ids[covered][:, 0] == 1).all() and (ids[covered][:, 2] == 1).all()
     assert set(np.unique(ids[covered][:, 1])) == {1, 2}
     assert (ids[~covered] == 0).all()
@@ -132,7 +133,10 @@ def test_scene_properties():
     assert scene.source == "builtin:teapot"
     (cx, cy, cz), r = scene.bounding_sphere
     assert r > 0
-    assert scene.draws and scene.draws[0]["id"] == 1
+    assert scene.primitives and scene.primitives[0]["id"] == 1
+    # The old name still answers, with a DeprecationWarning.
+    with pytest.warns(DeprecationWarning, match="Scene.primitives"):
+        assert scene.draws == scene.primitives
     assert "teapot" in repr(scene)
     m = scene.camera.world_to_camera_gl
     assert m.shape == (4, 4) and m.dtype == np.float32

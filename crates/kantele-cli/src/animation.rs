@@ -1,11 +1,11 @@
 //! Turntables: every view of a scene (`--orbit N`, `--views`) as one animated image, GIF or
-//! APNG, written atomically once the last frame is rendered.
+//! APNG, written with its sidecar (every frame's camera) once the last frame is rendered.
 
 use std::io::{self, Write};
 use std::path::Path;
 
 use kantele::backend::FrameImage;
-use kantele_io::output::write_atomic;
+use kantele_io::output::OutputSet;
 
 use crate::output::extension;
 
@@ -48,12 +48,12 @@ impl Animation {
         Ok(())
     }
 
-    /// Writes the animation to `path` (.gif or .apng), looping forever.
-    pub fn write(&self, path: &Path) -> anyhow::Result<()> {
+    /// Writes the animation to `path` (.gif or .apng), looping forever, as a file of `set`.
+    pub fn write(&self, set: &mut OutputSet, path: &Path) -> anyhow::Result<()> {
         if extension(path) == "gif" {
-            write_atomic(path, |w| self.encode_gif(w))?;
+            set.write(path, |w| self.encode_gif(w))?;
         } else {
-            write_atomic(path, |w| self.encode_apng(w))?;
+            set.write(path, |w| self.encode_apng(w))?;
         }
         Ok(())
     }
@@ -121,14 +121,18 @@ mod tests {
             })
             .is_err());
         let apng = dir.join("t.apng");
-        a.write(&apng).unwrap();
+        let mut set = OutputSet::new();
+        a.write(&mut set, &apng).unwrap();
+        set.commit().unwrap();
         let decoder =
             png::Decoder::new(std::io::BufReader::new(std::fs::File::open(&apng).unwrap()));
         let reader = decoder.read_info().unwrap();
         let control = reader.info().animation_control.unwrap();
         assert_eq!(control.num_frames, 5);
         let gif = dir.join("t.gif");
-        a.write(&gif).unwrap();
+        let mut set = OutputSet::new();
+        a.write(&mut set, &gif).unwrap();
+        set.commit().unwrap();
         use image::AnimationDecoder;
         let frames = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(
             std::fs::File::open(&gif).unwrap(),

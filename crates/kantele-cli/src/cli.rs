@@ -206,6 +206,12 @@ pub struct RenderArgs {
     /// CPU backend options.
     #[command(flatten)]
     pub cpu: CpuArgs,
+    /// Memory for one image's pixels while it is rendered and written (render target, readback
+    /// and file rows; about 56 bytes a pixel), e.g. 512M, 2G (default 1G). A bigger picture is
+    /// rendered in horizontal bands of whole 64-row tiles, each streamed into its files (PNG,
+    /// PFM, .npy; not .exr); the picture is bit-identical to an unbanded one.
+    #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]
+    pub frame_memory: Option<u64>,
     /// Print one JSON line per finished image on stdout.
     #[arg(long)]
     pub json: bool,

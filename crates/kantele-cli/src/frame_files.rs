@@ -1,5 +1,5 @@
-//! The files of one rendered image: what each holds (colour, depth, normals, ids) encoded into
-//! an [`OutputSet`], so a frame's files appear together or not at all.
+//! The files of one rendered image: what each holds (colour, depth, normals, ids) as values
+//! computed from a rendered frame or band; the encoding is in [`crate::frame_writer`].
 
 use std::io;
 use std::path::{Path, PathBuf};
@@ -8,10 +8,7 @@ use anyhow::{anyhow, bail, Result};
 use glam::{Mat3, Vec3};
 use kantele::backend::FrameImage;
 use kantele::scene::Scene;
-use kantele_io::output::{
-    encode_exr_gray32f, encode_exr_gray_u32, encode_exr_rgb32f, encode_exr_rgba32f, encode_npy,
-    encode_pfm, encode_png_gray16, encode_png_rgba8, NpyData, OutputSet,
-};
+use kantele_io::output::OutputSet;
 use kantele_io::pose::CameraPose;
 
 use crate::cli::{DepthKind, DepthUnit, IdKind, NormalSpace};
@@ -49,33 +46,14 @@ pub fn check_type(path: &str, flag: &str, allowed: &[&str]) -> Result<()> {
     Ok(())
 }
 
-/// Colour: 8-bit sRGB PNG, float EXR or float32 `.npy` (H, W, 4), linear.
-pub fn write_color(set: &mut OutputSet, path: &Path, frame: &FrameImage) -> Result<()> {
-    let (w, h) = (frame.width, frame.height);
-    match extension(path).as_str() {
-        "exr" | "npy" => {
-            let data: Vec<f32> = frame.color.iter().flatten().copied().collect();
-            if extension(path) == "exr" {
-                set.write(path, |o| encode_exr_rgba32f(o, w, h, &data))?;
-            } else {
-                let shape = [h as usize, w as usize, 4];
-                set.write(path, |o| encode_npy(o, &shape, NpyData::F32(&data)))?;
-            }
-        }
-        _ => {
-            let rgba = frame.to_rgba8(true);
-            set.write(path, |o| encode_png_rgba8(o, w, h, &rgba))?;
-        }
-    }
-    Ok(())
-}
-
-/// Depth values of a frame (eye and ray depth in `unit`), background `+inf` (window: 1).
+/// Depth values of a frame, or of a band of it starting at picture row `first_row` (eye and
+/// ray depth in `unit`), background `+inf` (window: 1).
 pub fn depth_values(
     frame: &FrameImage,
     kind: DepthKind,
     unit: DepthUnit,
     pose: &CameraPose,
+    first_row: u32,
 ) -> Vec<f32> {
     let scale = match unit {
         DepthUnit::M => 1.0,
@@ -84,7 +62,7 @@ pub fn depth_values(
     let mut values = match kind {
         DepthKind::Window => return frame.depth.clone(),
         DepthKind::Eye => pose.planar_depth(&frame.depth),
-        DepthKind::Ray => pose.ray_depth(&frame.depth),
+        DepthKind::Ray => pose.ray_depth_rows(&frame.depth, first_row),
     };
     if scale != 1.0 {
         for v in &mut values {
@@ -118,28 +96,6 @@ pub fn depth_png(values: &[f32], path: &Path) -> Result<Vec<u16>> {
     Ok(out)
 }
 
-/// Depth: 16-bit PNG, one-channel float EXR, PFM or float32 `.npy` (H, W).
-pub fn write_depth(
-    set: &mut OutputSet,
-    path: &Path,
-    frame: &FrameImage,
-    values: &[f32],
-) -> Result<()> {
-    let (w, h) = (frame.width, frame.height);
-    match extension(path).as_str() {
-        "png" => {
-            let gray = depth_png(values, path)?;
-            set.write(path, |o| encode_png_gray16(o, w, h, &gray))?;
-        }
-        "exr" => set.write(path, |o| encode_exr_gray32f(o, w, h, values))?,
-        "npy" => set.write(path, |o| {
-            encode_npy(o, &[h as usize, w as usize], NpyData::F32(values))
-        })?,
-        _ => set.write(path, |o| encode_pfm(o, w, h, values))?,
-    }
-    Ok(())
-}
-
 /// Unit normals of a normals-pass frame in `space` (camera: OpenCV axes), background 0.
 pub fn normal_values(frame: &FrameImage, space: NormalSpace, pose: &CameraPose) -> Vec<[f32; 3]> {
     let rotation = Mat3::from_mat4(pose.world_to_camera_opencv());
@@ -158,44 +114,6 @@ pub fn normal_values(frame: &FrameImage, space: NormalSpace, pose: &CameraPose) 
             }
         })
         .collect()
-}
-
-/// Normals: 8-bit PNG `n * 0.5 + 0.5` (background transparent black), float RGB EXR or float32
-/// `.npy` (H, W, 3).
-pub fn write_normals(
-    set: &mut OutputSet,
-    path: &Path,
-    frame: &FrameImage,
-    normals: &[[f32; 3]],
-) -> Result<()> {
-    let (w, h) = (frame.width, frame.height);
-    match extension(path).as_str() {
-        "exr" | "npy" => {
-            let rgb: Vec<f32> = normals.iter().flatten().copied().collect();
-            if extension(path) == "exr" {
-                set.write(path, |o| encode_exr_rgb32f(o, w, h, &rgb))?;
-            } else {
-                let shape = [h as usize, w as usize, 3];
-                set.write(path, |o| encode_npy(o, &shape, NpyData::F32(&rgb)))?;
-            }
-        }
-        _ => {
-            let enc = |v: f32| ((v * 0.5 + 0.5).clamp(0.0, 1.0) * 255.0).round() as u8;
-            let rgba: Vec<u8> = normals
-                .iter()
-                .zip(&frame.depth)
-                .flat_map(|(n, &d)| {
-                    if d >= 1.0 {
-                        [0; 4]
-                    } else {
-                        [enc(n[0]), enc(n[1]), enc(n[2]), 255]
-                    }
-                })
-                .collect();
-            set.write(path, |o| encode_png_rgba8(o, w, h, &rgba))?;
-        }
-    }
-    Ok(())
 }
 
 /// The largest id of `kind` the scene can produce (0 when it draws nothing).
@@ -275,31 +193,6 @@ pub fn id_values(frame: &FrameImage, scene: &Scene, kind: IdKind) -> Result<Vec<
             })
         })
         .collect()
-}
-
-/// Ids: 16-bit gray PNG, u32 EXR or uint32 `.npy` (H, W).
-pub fn write_ids(set: &mut OutputSet, path: &Path, frame: &FrameImage, ids: &[u32]) -> Result<()> {
-    let (w, h) = (frame.width, frame.height);
-    match extension(path).as_str() {
-        "png" => {
-            let gray = ids
-                .iter()
-                .map(|&v| u16::try_from(v))
-                .collect::<Result<Vec<u16>, _>>()
-                .map_err(|_| {
-                    anyhow!(
-                        "{}: an id does not fit a 16-bit PNG; write .exr or .npy",
-                        path.display()
-                    )
-                })?;
-            set.write(path, |o| encode_png_gray16(o, w, h, &gray))?;
-        }
-        "exr" => set.write(path, |o| encode_exr_gray_u32(o, w, h, ids))?,
-        _ => set.write(path, |o| {
-            encode_npy(o, &[h as usize, w as usize], NpyData::U32(ids))
-        })?,
-    }
-    Ok(())
 }
 
 /// The sidecar, last file of the set.

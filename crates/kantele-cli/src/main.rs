@@ -26,6 +26,7 @@ mod cli;
 mod compare;
 mod compare_cmd;
 mod frame_files;
+mod frame_writer;
 mod info;
 mod output;
 mod output_plan;

@@ -1,7 +1,8 @@
 //! `kantele render`: colour, depth, normal and id images with a JSON sidecar, each image's
 //! files written together ([`OutputSet`]), checked before anything is rendered.
 
-use std::io::{IsTerminal, Write};
+use std::io::IsTerminal;
+use std::ops::Range;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 use std::time::Instant;
@@ -9,9 +10,13 @@ use std::time::Instant;
 use anyhow::{anyhow, bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
+use kantele::band::{plan_bands, TARGET_BYTES_PER_PIXEL};
 use kantele::scene::Scene;
-use kantele_io::output::{encode_png_rgba8, OutputSet};
-use kantele_io::pose::sidecar::{DrawId, InstanceId, SidecarCamera, SidecarDepth, SidecarIds};
+use kantele::stats::FrameStats;
+use kantele::RenderError;
+use kantele_io::output::OutputSet;
+use kantele_io::pose::sidecar::{AnimationSidecar, InstanceId, PrimitiveId, SidecarCamera};
+use kantele_io::pose::sidecar::{SidecarDepth, SidecarIds};
 use kantele_io::pose::sidecar::{SidecarNormals, MATRIX_LAYOUT};
 use kantele_io::pose::{rows, CameraPose, Sidecar};
 use serde_json::json;
@@ -21,6 +26,7 @@ use crate::backends::make_backend;
 use crate::camera_args::CameraPlan;
 use crate::cli::{DepthKind, DepthUnit, NormalSpace, RenderArgs};
 use crate::frame_files::{self as files, FramePaths};
+use crate::frame_writer::{BandContext, Content, OutputFile};
 use crate::output::{digits_for, expand_template, extension, has_placeholder, TemplateVars};
 use crate::output_plan::OutputGuard;
 use crate::scenes::{self, Input, Warnings};
@@ -30,7 +36,7 @@ use crate::signals::InterruptFlag;
 pub const STDOUT: &str = "-";
 
 /// What the id files hold, for the sidecar.
-const ID_FILES: &str = "one channel per file (see files), 0 = background: instance = node_index + 1, mesh = mesh index + 1, material = material index + 1, primitive = draw id (draw index + 1), triangle = triangle index in its draw + 1";
+const ID_FILES: &str = "one channel per file (see files), 0 = background: instance = node_index + 1, mesh = mesh index + 1, material = material index + 1, primitive = a mesh primitive placed by a node (one draw; see primitive_ids), triangle = triangle index in its primitive + 1";
 
 /// The unit of eye and ray depth: `--depth-unit`, else millimetres for PNG and metres otherwise.
 fn depth_unit(args: &RenderArgs) -> DepthUnit {
@@ -124,14 +130,11 @@ fn plan_outputs(
             } else {
                 Some(expand(&args.output)?)
             };
-            let sidecar = color
-                .as_ref()
-                .filter(|_| !is_animation(&args.output))
-                .map(|c| {
-                    let mut s = c.clone().into_os_string();
-                    s.push(".json");
-                    PathBuf::from(s)
-                });
+            let sidecar = color.as_ref().map(|c| {
+                let mut s = c.clone().into_os_string();
+                s.push(".json");
+                PathBuf::from(s)
+            });
             let paths = FramePaths {
                 color,
                 sidecar,
@@ -154,36 +157,80 @@ fn plan_outputs(
     Ok(plan)
 }
 
-/// Renders one pass and checks the frame's size.
+/// Renders one whole frame of one pass and checks its size (the backend must render whole
+/// frames: no render region set).
 pub fn render_pass(
     backend: &mut dyn Backend,
     view: &FrameView,
     label: &str,
+    interrupt: &InterruptFlag,
 ) -> Result<(FrameImage, f64)> {
-    let start = Instant::now();
-    let stats = backend.render(view).map_err(|e| anyhow!("{label}: {e}"))?;
-    let ms = start.elapsed().as_secs_f64() * 1000.0;
-    if view.pass == kantele::backend::Pass::Color {
-        if let Some(warning) = stats.empty_picture_warning() {
+    let band = render_band(backend, view, 0..view.height, label, interrupt)?;
+    if view.pass == Pass::Color {
+        if let Some(warning) = band.stats.empty_picture_warning() {
             eprintln!("kantele: warning: {label}: {warning}");
         }
     }
+    Ok((band.frame, band.ms))
+}
+
+/// A rendered band: its frame (`rows` of the view), the frame's counters and time.
+struct RenderedBand {
+    frame: FrameImage,
+    stats: FrameStats,
+    ms: f64,
+}
+
+/// Renders rows `rows` of one pass (the backend's render region must be those rows, or none
+/// for a whole frame) and checks the band's size. An interrupt that cancelled the frame is
+/// [`Interrupted`](crate::signals::Interrupted).
+fn render_band(
+    backend: &mut dyn Backend,
+    view: &FrameView,
+    rows: Range<u32>,
+    label: &str,
+    interrupt: &InterruptFlag,
+) -> Result<RenderedBand> {
+    let start = Instant::now();
+    let stats = match backend.render(view) {
+        Err(RenderError::Cancelled) => {
+            interrupt.check()?;
+            bail!("{label}: frame cancelled")
+        }
+        other => other.map_err(|e| anyhow!("{label}: {e}"))?,
+    };
+    let ms = start.elapsed().as_secs_f64() * 1000.0;
     let frame = backend.read_frame().map_err(|e| anyhow!("{label}: {e}"))?;
-    let n = view.width as usize * view.height as usize;
-    if (frame.width, frame.height) != (view.width, view.height)
+    let n = view.width as usize * rows.len();
+    if (frame.width, frame.height) != (view.width, rows.len() as u32)
         || frame.color.len() != n
         || frame.depth.len() != n
     {
         bail!(
-            "{label}: {} backend returned a {}x{} frame for a {}x{} view",
+            "{label}: {} backend returned a {}x{} frame for rows {}..{} of a {}x{} view",
             backend.name(),
             frame.width,
             frame.height,
+            rows.start,
+            rows.end,
             view.width,
             view.height
         );
     }
-    Ok((frame, ms))
+    Ok(RenderedBand { frame, stats, ms })
+}
+
+/// Bytes a pixel of a band costs the CLI: the CPU backend's tiles (linear RGBA + depth,
+/// `f32`), the band read back (the same again) and the rows converted for the files (at most
+/// 16 bytes: normals as three floats plus their PNG bytes).
+pub const BAND_BYTES_PER_PIXEL: usize = 2 * TARGET_BYTES_PER_PIXEL + 16;
+
+/// The default frame memory budget (`--frame-memory`): 1 GiB.
+pub const DEFAULT_FRAME_MEMORY: u64 = 1 << 30;
+
+/// The frame memory budget of `render`.
+fn frame_memory(args: &RenderArgs) -> usize {
+    usize::try_from(args.frame_memory.unwrap_or(DEFAULT_FRAME_MEMORY)).unwrap_or(usize::MAX)
 }
 
 /// The sidecar's depth entry.
@@ -241,11 +288,11 @@ fn sidecar(args: &RenderArgs, s: &SidecarInputs<'_>) -> Sidecar {
             node_name,
         })
         .collect();
-    let draw_ids = scene
+    let primitive_ids = scene
         .draws
         .iter()
         .enumerate()
-        .map(|(i, d)| DrawId {
+        .map(|(i, d)| PrimitiveId {
             id: i + 1,
             mesh_index: d.mesh,
             mesh_name: scene
@@ -294,7 +341,7 @@ fn sidecar(args: &RenderArgs, s: &SidecarInputs<'_>) -> Sidecar {
                 .map(|(k, p)| (k.name().to_string(), path(p)))
                 .collect(),
             instance_ids,
-            draw_ids,
+            primitive_ids,
         },
     }
 }
@@ -309,7 +356,9 @@ struct SceneJob<'a> {
 }
 
 impl SceneJob<'_> {
-    /// Renders one view and writes its files together; an interrupt drops them all.
+    /// Renders one view and writes its files together; an interrupt drops them all. A picture
+    /// whose pixels would exceed the frame memory budget is rendered in horizontal bands, each
+    /// band's rows streamed into every file before the next band is drawn.
     fn render_view(
         &self,
         backend: &mut dyn Backend,
@@ -318,42 +367,96 @@ impl SceneJob<'_> {
         interrupt: &InterruptFlag,
     ) -> Result<f64> {
         let (args, label, scene) = (self.args, &self.label, &self.scene);
-        let mut view = pose.frame_view(scene, Pass::Color);
-        let (color, ms) = render_pass(backend, &view, label)?;
-        interrupt.check()?;
-        let Some(color_path) = &paths.color else {
-            let rgba = color.to_rgba8(true);
-            let mut buffer = std::io::Cursor::new(Vec::new());
-            encode_png_rgba8(&mut buffer, color.width, color.height, &rgba)
-                .map_err(|e| anyhow!("standard output: {e}"))?;
-            let mut out = std::io::stdout().lock();
-            out.write_all(buffer.get_ref())
-                .and_then(|()| out.flush())
-                .map_err(|e| anyhow!("standard output: {e}"))?;
-            return Ok(ms);
-        };
+        let (width, height) = (pose.width, pose.height);
+        let bands = plan_bands(width, height, BAND_BYTES_PER_PIXEL, frame_memory(args));
+        if bands.len() > 1 {
+            backend
+                .set_render_region(Some(bands[0].clone()))
+                .map_err(|e| anyhow!("{label}: a {width}x{height} picture needs {} bands within the frame memory budget, and {e}; raise --frame-memory or use the cpu backend", bands.len()))?;
+        }
         let mut set = OutputSet::new();
-        files::write_color(&mut set, color_path, &color)?;
-        if let Some(p) = &paths.depth {
-            let values = files::depth_values(&color, args.extra.depth_kind, depth_unit(args), pose);
-            files::write_depth(&mut set, p, &color, &values)?;
+        let mut outputs = Vec::new();
+        let extra = &args.extra;
+        let contents = std::iter::once((paths.color.as_deref(), Content::Color))
+            .chain(
+                paths
+                    .depth
+                    .as_deref()
+                    .map(|p| (Some(p), Content::Depth(extra.depth_kind, depth_unit(args)))),
+            )
+            .chain(
+                paths
+                    .normals
+                    .as_deref()
+                    .map(|p| (Some(p), Content::Normals(extra.normals_space))),
+            )
+            .chain(
+                paths
+                    .ids
+                    .iter()
+                    .map(|(k, p)| (Some(p.as_path()), Content::Ids(*k))),
+            );
+        for (path, content) in contents {
+            outputs.push(OutputFile::open(
+                &mut set,
+                path,
+                content,
+                (width, height),
+                bands.len(),
+            )?);
         }
-        if let Some(p) = &paths.normals {
-            view.pass = Pass::Normals;
-            let frame = render_pass(backend, &view, label)?.0;
+        let normals_pass = outputs.iter().any(OutputFile::needs_normals_pass);
+        let ids_pass = outputs.iter().any(OutputFile::needs_ids_pass);
+        let mut ms = 0.0;
+        let mut covered = 0;
+        let mut empty_warning = None;
+        for rows in &bands {
             interrupt.check()?;
-            let normals = files::normal_values(&frame, args.extra.normals_space, pose);
-            files::write_normals(&mut set, p, &frame, &normals)?;
-        }
-        if !paths.ids.is_empty() {
-            view.pass = Pass::Ids;
-            let frame = render_pass(backend, &view, label)?.0;
-            interrupt.check()?;
-            for (kind, p) in &paths.ids {
-                let ids = files::id_values(&frame, scene, *kind)
-                    .map_err(|e| anyhow!("{}: {e}", p.display()))?;
-                files::write_ids(&mut set, p, &frame, &ids)?;
+            let region = (bands.len() > 1).then(|| rows.clone());
+            backend
+                .set_render_region(region)
+                .map_err(|e| anyhow!("{label}: {e}"))?;
+            let ctx = BandContext {
+                pose,
+                scene,
+                first_row: rows.start,
+                interrupt,
+            };
+            let mut view = pose.frame_view(scene, Pass::Color);
+            let band = render_band(backend, &view, rows.clone(), label, interrupt)?;
+            ms += band.ms;
+            covered += band.stats.fragments_covered;
+            empty_warning = empty_warning.or(band.stats.empty_picture_warning());
+            for out in outputs
+                .iter_mut()
+                .filter(|o| !o.needs_normals_pass() && !o.needs_ids_pass())
+            {
+                out.write_band(&mut set, &band.frame, &ctx)?;
             }
+            for (pass, wanted) in [(Pass::Normals, normals_pass), (Pass::Ids, ids_pass)] {
+                if !wanted {
+                    continue;
+                }
+                interrupt.check()?;
+                view.pass = pass;
+                let band = render_band(backend, &view, rows.clone(), label, interrupt)?;
+                for out in outputs.iter_mut().filter(|o| {
+                    (pass == Pass::Normals && o.needs_normals_pass())
+                        || (pass == Pass::Ids && o.needs_ids_pass())
+                }) {
+                    out.write_band(&mut set, &band.frame, &ctx)?;
+                }
+            }
+        }
+        backend
+            .set_render_region(None)
+            .map_err(|e| anyhow!("{label}: {e}"))?;
+        if let Some(warning) = empty_warning.filter(|_| covered == 0) {
+            eprintln!("kantele: warning: {label}: {warning}");
+        }
+        interrupt.check()?;
+        for out in outputs {
+            out.finish()?;
         }
         if let Some(p) = &paths.sidecar {
             let meta = sidecar(
@@ -412,6 +515,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let total = inputs.len() * views;
 
     let mut backend = make_backend(args.backend, &args.cpu, false)?;
+    // Ctrl-C and SIGTERM cancel the frame in flight, not only the next one.
+    backend.set_cancel_flag(Some(interrupt.flag()));
     let progress = progress_bar(total);
     let mut warnings = Warnings::default();
 
@@ -453,17 +558,48 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 continue;
             }
             let mut animation = Animation::new(width, height, args.fps);
+            let mut views = Vec::new();
+            let frame_paths = FramePaths {
+                color: Some(path.clone()),
+                ..FramePaths::default()
+            };
             for pose in &poses {
                 interrupt.check()?;
                 let view = pose.frame_view(&job.scene, Pass::Color);
-                let frame = render_pass(backend.as_mut(), &view, &job.label)?.0;
+                let (frame, ms) = render_pass(backend.as_mut(), &view, &job.label, &interrupt)?;
                 animation
                     .push(&frame)
                     .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+                views.push(sidecar(
+                    args,
+                    &SidecarInputs {
+                        input,
+                        source: &job.source,
+                        scene: &job.scene,
+                        pose,
+                        paths: &frame_paths,
+                        backend: backend.as_ref(),
+                        ms,
+                    },
+                ));
                 progress.inc(1);
             }
             interrupt.check()?;
-            animation.write(path)?;
+            let mut set = OutputSet::new();
+            animation.write(&mut set, path)?;
+            let meta = AnimationSidecar {
+                scene: input.stem(),
+                source: job.source.clone(),
+                output: path.display().to_string(),
+                fps: args.fps,
+                frames: views.len(),
+                views,
+            };
+            if let Some(p) = &outs[0].sidecar {
+                files::write_json(&mut set, p, &meta)?;
+            }
+            interrupt.check()?;
+            set.commit()?;
             continue;
         }
         for (pose, paths) in poses.iter().zip(outs) {

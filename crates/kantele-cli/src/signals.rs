@@ -1,4 +1,5 @@
-//! Ctrl-C and SIGTERM as a flag: the command checks it between passes and frames, drops the
+//! Ctrl-C and SIGTERM as a flag: the CPU backend watches it inside a frame (the frame stops
+//! within a fraction of a second), the command checks it between passes and frames, drops the
 //! frame in flight (its temporaries are removed by `OutputSet`'s drop) and exits with 130.
 
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -33,6 +34,12 @@ impl InterruptFlag {
             signal_hook::flag::register(signal, flag.clone())?;
         }
         Ok(Self(flag))
+    }
+
+    /// The flag itself, for a backend to cancel the frame in flight
+    /// ([`kantele::backend::Backend::set_cancel_flag`]).
+    pub fn flag(&self) -> Arc<AtomicBool> {
+        self.0.clone()
     }
 
     /// `Err(Interrupted)` once a signal arrived.

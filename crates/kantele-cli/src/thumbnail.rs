@@ -54,7 +54,9 @@ pub fn run(args: &ThumbnailArgs) -> Result<()> {
         .load(scene.clone())
         .map_err(|e| anyhow!("{label}: {e}"))?;
     let view = pose.frame_view(&scene, Pass::Color);
-    let (frame, _) = crate::render_cmd::render_pass(backend.as_mut(), &view, &label)?;
+    let interrupt = crate::signals::InterruptFlag::install()?;
+    backend.set_cancel_flag(Some(interrupt.flag()));
+    let (frame, _) = crate::render_cmd::render_pass(backend.as_mut(), &view, &label, &interrupt)?;
     let rgba = frame.to_rgba8(true);
     write_atomic(&args.output, |w| {
         encode_png_rgba8(w, frame.width, frame.height, &rgba)

@@ -462,7 +462,58 @@ fn orbit_straight_to_an_animation() {
     .unwrap();
     let frames = png.apng().unwrap().into_frames().collect_frames().unwrap();
     assert_eq!(frames.len(), 3);
-    assert_eq!(dir.files(), ["spin.apng", "spin.gif"]);
+    assert_eq!(
+        dir.files(),
+        ["spin.apng", "spin.apng.json", "spin.gif", "spin.gif.json"]
+    );
+}
+
+#[test]
+fn turntable_sidecar_reproduces_every_frame() {
+    use image::AnimationDecoder;
+    let dir = TempDir::new("turntable-sidecar");
+    ok(&kantele(&[
+        "render",
+        "--builtin",
+        "teapot",
+        "--size",
+        "48x36",
+        "--orbit",
+        "4",
+        "--elevation",
+        "35",
+        "-o",
+        &dir.s("spin.apng"),
+    ]));
+    let side: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(dir.path("spin.apng.json")).unwrap()).unwrap();
+    assert_eq!(side["frames"].as_u64(), Some(4));
+    assert_eq!(side["views"].as_array().map(Vec::len), Some(4));
+    let png = image::codecs::png::PngDecoder::new(std::io::BufReader::new(
+        std::fs::File::open(dir.path("spin.apng")).unwrap(),
+    ))
+    .unwrap();
+    let frames = png.apng().unwrap().into_frames().collect_frames().unwrap();
+    // Every frame's pose read back renders that frame again, pixel for pixel.
+    ok(&kantele(&[
+        "render",
+        "--builtin",
+        "teapot",
+        "--views",
+        &dir.s("spin.apng.json"),
+        "-o",
+        &dir.s("view{frame}.png"),
+    ]));
+    for (k, frame) in frames.iter().enumerate() {
+        let view = image::open(dir.path(&format!("view{k:04}.png")))
+            .unwrap()
+            .into_rgba8();
+        assert!(
+            view == *frame.buffer(),
+            "frame {k} differs from its pose rendered again"
+        );
+    }
+    assert_ne!(frames[0].buffer(), frames[1].buffer(), "the views turn");
 }
 
 #[test]

@@ -51,6 +51,7 @@ pub mod output;
 pub mod pose;
 mod quiet_panic;
 mod read_policy;
+pub mod row_writer;
 mod texture_util;
 mod uri;
 

@@ -76,6 +76,14 @@ fn write_temp(
     }
 }
 
+/// Flushes a writer from [`OutputSet::create`] and syncs its file, reporting errors that a
+/// plain drop would lose.
+pub fn close_file(writer: FileWriter) -> io::Result<()> {
+    let file = writer.into_inner().map_err(|e| e.into_error())?;
+    file.sync_all().ok();
+    Ok(())
+}
+
 /// Writes a file through a temporary name in the same folder, renamed into place only when
 /// `write` succeeded; nothing is left behind on failure.
 pub fn write_atomic(
@@ -119,6 +127,20 @@ impl OutputSet {
         let tmp = write_temp(path, write)?;
         self.pending.push((tmp, path.to_path_buf()));
         Ok(())
+    }
+
+    /// Starts `path`'s content as a temporary file that stays open for writing, for content
+    /// produced piece by piece (rows streamed band by band, [`crate::row_writer`]). The
+    /// temporary is pending at once: [`OutputSet::commit`] moves it into place with the
+    /// others (finish writing it first), and dropping the set removes it.
+    pub fn create(&mut self, path: &Path) -> Result<FileWriter, OutputError> {
+        if self.pending.iter().any(|(_, p)| p == path) {
+            return Err(output_error(path, "written twice in one frame"));
+        }
+        let tmp = temp_path(path)?;
+        let file = File::create(&tmp).map_err(|e| output_error(path, e))?;
+        self.pending.push((tmp, path.to_path_buf()));
+        Ok(BufWriter::new(file))
     }
 
     /// The final paths written so far.
@@ -417,6 +439,29 @@ impl NpyData<'_> {
     }
 }
 
+/// Writes the header of a C-order NumPy array (format 1.0) of `shape` and element type `descr`
+/// (`<f4`, `<u2`, `<u4`); the values follow it, little-endian.
+pub(crate) fn write_npy_header(
+    out: &mut impl Write,
+    shape: &[usize],
+    descr: &str,
+) -> io::Result<()> {
+    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
+    // A 1-tuple needs its comma.
+    let comma = if dims.len() == 1 { "," } else { "" };
+    let mut header = format!(
+        "{{'descr': '{descr}', 'fortran_order': False, 'shape': ({}{comma}), }}",
+        dims.join(", ")
+    );
+    // Magic (6) + version (2) + length (2) + header + '\n' is a multiple of 64.
+    let unpadded = 10 + header.len() + 1;
+    header.push_str(&" ".repeat(unpadded.next_multiple_of(64) - unpadded));
+    header.push('\n');
+    out.write_all(b"\x93NUMPY\x01\x00")?;
+    out.write_all(&(header.len() as u16).to_le_bytes())?;
+    out.write_all(header.as_bytes())
+}
+
 /// Encodes a C-order NumPy array (format 1.0) of shape `(H, W)` or `(H, W, C)`, little-endian.
 pub fn encode_npy(out: &mut impl Write, shape: &[usize], data: NpyData<'_>) -> io::Result<()> {
     let count = shape.iter().try_fold(1usize, |n, &d| n.checked_mul(d));
@@ -429,19 +474,7 @@ pub fn encode_npy(out: &mut impl Write, shape: &[usize], data: NpyData<'_>) -> i
             ),
         ));
     }
-    let dims: Vec<String> = shape.iter().map(|d| d.to_string()).collect();
-    let mut header = format!(
-        "{{'descr': '{}', 'fortran_order': False, 'shape': ({}), }}",
-        data.descr(),
-        dims.join(", ")
-    );
-    // Magic (6) + version (2) + length (2) + header + '\n' is a multiple of 64.
-    let unpadded = 10 + header.len() + 1;
-    header.push_str(&" ".repeat(unpadded.next_multiple_of(64) - unpadded));
-    header.push('\n');
-    out.write_all(b"\x93NUMPY\x01\x00")?;
-    out.write_all(&(header.len() as u16).to_le_bytes())?;
-    out.write_all(header.as_bytes())?;
+    write_npy_header(out, shape, data.descr())?;
     match data {
         NpyData::F32(v) => out.write_all(&ne_bytes(v, f32::to_le_bytes)),
         NpyData::U16(v) => out.write_all(&ne_bytes(v, u16::to_le_bytes)),

@@ -4,6 +4,8 @@
 //! Loading (uploading meshes and textures, building mip levels) is outside a frame; a frame is
 //! clear + every draw + waiting for the image to be complete, as the timing rules require.
 
+use std::ops::Range;
+use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
@@ -21,8 +23,9 @@ pub enum Pass {
     /// World-space unit normals (after two-sided flipping) in RGB, alpha 1; background is the
     /// clear value 0.
     Normals,
-    /// Exact integer ids stored in float channels: R = draw's `node_index + 1`, G = triangle
-    /// index within its mesh + 1, B = draw index + 1; background 0.
+    /// Exact integer ids stored in float channels: R = instance id (the draw's `node_index +
+    /// 1`), G = triangle id (triangle index within its mesh + 1), B = primitive id (draw index
+    /// + 1: in glTF terms a mesh primitive placed by a node); background 0.
     Ids,
 }
 
@@ -121,6 +124,26 @@ pub trait Backend {
     /// where the question does not apply (a GPU driver).
     fn isa(&self) -> String {
         "-".to_string()
+    }
+    /// Restricts the following frames to the pixel rows `rows` of their view (a render
+    /// region; `None`: whole frames again). The viewport stays the whole view's, so a band is
+    /// bit-identical to the same rows of the whole frame; [`Backend::read_frame`] returns only
+    /// those rows (`height` = rows in the band). Backends that cannot render regions refuse
+    /// with [`RenderError::Unsupported`]; the default refuses every region.
+    fn set_render_region(&mut self, rows: Option<Range<u32>>) -> Result<(), RenderError> {
+        match rows {
+            None => Ok(()),
+            Some(_) => Err(RenderError::Unsupported {
+                backend: self.name().to_string(),
+                message: "cannot render a region (band) of a frame".into(),
+            }),
+        }
+    }
+    /// A flag that cancels the frame in flight while it is `true`: [`Backend::render`] then
+    /// returns [`RenderError::Cancelled`] soon after it is set. The default ignores the flag
+    /// (frames of such a backend always finish).
+    fn set_cancel_flag(&mut self, flag: Option<Arc<AtomicBool>>) {
+        let _ = flag;
     }
     /// Takes the scene and uploads what it needs. Not part of a frame.
     fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError>;

@@ -13,6 +13,14 @@ pub enum RenderError {
         /// Requested height in pixels.
         height: u32,
     },
+    /// A render region (band of rows) that is empty or reaches past the target.
+    #[error("invalid render region: rows {}..{} of a target {height} rows high", rows.0, rows.1)]
+    InvalidRegion {
+        /// The requested rows, `start..end`.
+        rows: (u32, u32),
+        /// The target's height.
+        height: u32,
+    },
     /// Memory for a render target or texture could not be reserved.
     #[error("out of memory: cannot reserve {bytes} bytes for {what}")]
     OutOfMemory {

@@ -102,6 +102,7 @@
 #![deny(unsafe_code)]
 
 pub mod backend;
+pub mod band;
 pub mod camera;
 pub mod color;
 pub mod compare;

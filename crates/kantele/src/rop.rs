@@ -220,18 +220,35 @@ pub fn readback_bytes(width: u32, height: u32, bytes_per_pixel: usize) -> usize 
         .saturating_mul(bytes_per_pixel)
 }
 
-/// A colour + depth target stored as tiles.
+/// A colour + depth target stored as tiles. It may hold only a band of the target's rows
+/// ([`Framebuffer::rows`]): the viewport is the whole target's, readback returns the band.
 #[derive(Clone, Debug)]
 pub struct Framebuffer {
     grid: TileGrid,
     tiles: Vec<TileBuffer>,
+    /// The pixel rows held and read back (`0..height` for a whole target).
+    rows: std::ops::Range<u32>,
 }
 
 impl Framebuffer {
     /// A target of `width × height` (sizes checked by the caller), cleared to transparent black
     /// and depth 1.
     pub(crate) fn new(width: u32, height: u32) -> Result<Self, RenderError> {
-        let grid = TileGrid::new(width, height);
+        Self::band(width, height, 0..height)
+    }
+
+    /// Rows `rows` (non-empty, within `0..height`, checked by the caller) of a `width × height`
+    /// target: only the tiles holding them are allocated.
+    pub(crate) fn band(
+        width: u32,
+        height: u32,
+        rows: std::ops::Range<u32>,
+    ) -> Result<Self, RenderError> {
+        let grid = TileGrid::band(
+            width,
+            height,
+            rows.start >> TILE_LOG2..rows.end.div_ceil(TILE_SIZE),
+        );
         let mut tiles = Vec::new();
         tiles
             .try_reserve_exact(grid.tile_count())
@@ -242,7 +259,7 @@ impl Framebuffer {
         for _ in 0..grid.tile_count() {
             tiles.push(TileBuffer::new()?);
         }
-        Ok(Self { grid, tiles })
+        Ok(Self { grid, tiles, rows })
     }
 
     /// Width in pixels.
@@ -250,9 +267,14 @@ impl Framebuffer {
         self.grid.width
     }
 
-    /// Height in pixels.
+    /// Height in pixels (of the whole target, also when only a band is held).
     pub fn height(&self) -> u32 {
         self.grid.height
+    }
+
+    /// The pixel rows held and read back: `0..height()` unless the target is a band.
+    pub fn rows(&self) -> std::ops::Range<u32> {
+        self.rows.clone()
     }
 
     /// The tile layout.
@@ -276,7 +298,7 @@ impl Framebuffer {
     // output at a time: the streaming readers add one row to the framebuffer's memory, the
     // whole-frame readers exactly their result (reserved fallibly in the `try_` forms).
 
-    /// Calls `emit(y, row)` for every row, top to bottom, with `row` holding `per_pixel`
+    /// Calls `emit(y, row)` for every row held, top to bottom, with `row` holding `per_pixel`
     /// values per pixel made by `get(tile, index, out)`; one row buffer is reused.
     fn read_rows<T: Copy + Default>(
         &self,
@@ -286,8 +308,9 @@ impl Framebuffer {
     ) {
         let w = self.grid.width as usize;
         let mut row = vec![T::default(); w * per_pixel];
-        for y in 0..self.grid.height {
-            let tile_row = (y as usize >> TILE_LOG2) * self.grid.tiles_x as usize;
+        for y in self.rows.clone() {
+            let band_row = (y >> TILE_LOG2) - self.grid.first_row;
+            let tile_row = band_row as usize * self.grid.tiles_x as usize;
             for (x, out) in row.chunks_exact_mut(per_pixel).enumerate() {
                 let tile = &self.tiles[tile_row + (x >> TILE_LOG2)];
                 get(tile, TileBuffer::index(x as i32, y as i32), out);
@@ -327,7 +350,7 @@ impl Framebuffer {
 
     /// Bytes a whole-frame readback of `bytes_per_pixel` per pixel takes for this target.
     pub fn readback_bytes(&self, bytes_per_pixel: usize) -> usize {
-        readback_bytes(self.grid.width, self.grid.height, bytes_per_pixel)
+        readback_bytes(self.grid.width, self.rows.len() as u32, bytes_per_pixel)
     }
 
     /// Collects rows into one vector of exactly `width × height × per_pixel` values, reserved
@@ -338,7 +361,7 @@ impl Framebuffer {
         what: &'static str,
         stream: impl FnOnce(&mut dyn FnMut(u32, &[T])),
     ) -> Result<Vec<T>, RenderError> {
-        let len = self.grid.width as usize * self.grid.height as usize * per_pixel;
+        let len = self.grid.width as usize * self.rows.len() * per_pixel;
         let mut out = Vec::new();
         out.try_reserve_exact(len)
             .map_err(|_| RenderError::OutOfMemory {
@@ -389,11 +412,11 @@ impl Framebuffer {
 
     /// The tile and the index within it of pixel `(x, y)`, if it lies on the target.
     fn locate(&self, x: u32, y: u32) -> Option<(&TileBuffer, usize)> {
-        if x >= self.grid.width || y >= self.grid.height {
+        if x >= self.grid.width || !self.rows.contains(&y) {
             return None;
         }
-        let tile =
-            (y >> TILE_LOG2) as usize * self.grid.tiles_x as usize + (x >> TILE_LOG2) as usize;
+        let band_row = (y >> TILE_LOG2) - self.grid.first_row;
+        let tile = band_row as usize * self.grid.tiles_x as usize + (x >> TILE_LOG2) as usize;
         Some((&self.tiles[tile], TileBuffer::index(x as i32, y as i32)))
     }
 

@@ -530,11 +530,17 @@ impl CameraPose {
 
     /// Ray distance of every pixel of a row-major window-depth buffer (background `+inf`).
     pub fn ray_depth(&self, window_depth: &[f32]) -> Vec<f32> {
+        self.ray_depth_rows(window_depth, 0)
+    }
+
+    /// [`CameraPose::ray_depth`] of a band of whole rows starting at picture row `first_row`
+    /// (a picture rendered in bands).
+    pub fn ray_depth_rows(&self, window_depth: &[f32], first_row: u32) -> Vec<f32> {
         let w = self.width.max(1) as usize;
         self.planar_depth(window_depth)
             .into_iter()
             .enumerate()
-            .map(|(i, z)| self.ray_distance(z, (i % w) as u32, (i / w) as u32))
+            .map(|(i, z)| self.ray_distance(z, (i % w) as u32, first_row + (i / w) as u32))
             .collect()
     }
 }

@@ -31,7 +31,7 @@ pub const PIXEL_CENTERS: &str =
 pub const MATRIX_LAYOUT: &str =
     "row-major: matrix[row][column]; points are columns (p_cam = M * p_world)";
 /// What [`SidecarIds::channels`] says.
-pub const ID_CHANNELS: &str = "R = instance id (node_index + 1), G = primitive id (triangle index in its mesh + 1), B = draw id (draw index + 1); 0 = background";
+pub const ID_CHANNELS: &str = "R = instance id (node_index + 1), G = triangle id (triangle index in its primitive + 1), B = primitive id (draw index + 1: a mesh primitive placed by a node); 0 = background";
 
 /// One rendered view: the picture's files, the renderer, and the camera.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -68,6 +68,24 @@ pub struct Sidecar {
     pub normals: Option<SidecarNormals>,
     /// The id image and what the ids mean.
     pub ids: SidecarIds,
+}
+
+/// The sidecar of an animation (a turntable, `--orbit N -o spin.gif`): one [`Sidecar`] per
+/// frame, frame `k` at `views[k]`. As a views file (`--views`) it renders every frame again.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct AnimationSidecar {
+    /// The scene's file stem or built-in name.
+    pub scene: String,
+    /// Where the scene came from (path or `builtin:NAME`).
+    pub source: String,
+    /// The animation's path.
+    pub output: String,
+    /// Frames per second.
+    pub fps: u16,
+    /// Number of frames (`views.len()`).
+    pub frames: usize,
+    /// Each frame's view, in frame order.
+    pub views: Vec<Sidecar>,
 }
 
 /// The kind of projection a sidecar camera has.
@@ -173,14 +191,17 @@ pub struct SidecarIds {
     pub file: Option<String>,
     /// What each channel holds ([`ID_CHANNELS`]).
     pub channels: String,
-    /// One-channel id files by kind (`instance`, `mesh`, `material`, `primitive` = draw id,
-    /// `triangle` = triangle index in its draw + 1), each 0 on the background.
+    /// One-channel id files by kind (`instance`, `mesh`, `material`, `primitive` = a glTF mesh
+    /// primitive placed by a node, i.e. one draw, `triangle` = triangle index in its primitive
+    /// + 1), each 0 on the background.
     #[serde(default, skip_serializing_if = "std::collections::BTreeMap::is_empty")]
     pub files: std::collections::BTreeMap<String, String>,
     /// Instance ids and their nodes.
     pub instance_ids: Vec<InstanceId>,
-    /// Draw ids and their meshes and nodes.
-    pub draw_ids: Vec<DrawId>,
+    /// Primitive ids (one per draw: a mesh primitive placed by a node) and their meshes and
+    /// nodes. Sidecars written before the id names were unified call this `draw_ids`.
+    #[serde(alias = "draw_ids")]
+    pub primitive_ids: Vec<PrimitiveId>,
 }
 
 /// One instance id.
@@ -194,9 +215,9 @@ pub struct InstanceId {
     pub node_name: String,
 }
 
-/// One draw id.
+/// One primitive id: a glTF mesh primitive placed by a node (one draw).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct DrawId {
+pub struct PrimitiveId {
     /// The id (draw index + 1).
     pub id: usize,
     /// The mesh drawn.

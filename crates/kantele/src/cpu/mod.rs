@@ -31,6 +31,8 @@ impl PreparedMesh {
 pub struct CpuBackend {
     renderer: Renderer,
     scene: Option<(Arc<Scene>, Vec<PreparedMesh>)>,
+    /// The rows frames are restricted to (`None`: whole frames).
+    region: Option<std::ops::Range<u32>>,
 }
 
 impl CpuBackend {
@@ -39,6 +41,7 @@ impl CpuBackend {
         Ok(Self {
             renderer: Renderer::new(1, 1, options)?,
             scene: None,
+            region: None,
         })
     }
 
@@ -50,13 +53,6 @@ impl CpuBackend {
     /// Changes the traversal strategy (pictures stay identical).
     pub fn set_strategy(&mut self, strategy: Strategy) {
         self.renderer.set_strategy(strategy);
-    }
-
-    /// A flag that cancels the frame in flight while it is `true` (see
-    /// [`Renderer::set_cancel_flag`]): [`Backend::render`] then returns
-    /// [`RenderError::Cancelled`]. The time budget is [`CpuOptions::timeout`].
-    pub fn set_cancel_flag(&mut self, flag: Option<std::sync::Arc<std::sync::atomic::AtomicBool>>) {
-        self.renderer.set_cancel_flag(flag);
     }
 
     /// Changes the time budget of a frame (`None`: unlimited); a frame over it makes
@@ -88,6 +84,29 @@ impl Backend for CpuBackend {
         self.renderer.isa().name().to_string()
     }
 
+    /// Restricts frames to rows `rows` of their view ([`Renderer::resize_band`]): only those
+    /// tiles are allocated, binned and drawn. A region past a frame's height is an error of
+    /// that frame's [`Backend::render`].
+    fn set_render_region(&mut self, rows: Option<std::ops::Range<u32>>) -> Result<(), RenderError> {
+        if let Some(r) = &rows {
+            if r.is_empty() {
+                return Err(RenderError::InvalidRegion {
+                    rows: (r.start, r.end),
+                    height: 0,
+                });
+            }
+        }
+        self.region = rows;
+        Ok(())
+    }
+
+    /// A flag that cancels the frame in flight while it is `true` (see
+    /// [`Renderer::set_cancel_flag`]): [`Backend::render`] then returns
+    /// [`RenderError::Cancelled`]. The time budget is [`CpuOptions::timeout`].
+    fn set_cancel_flag(&mut self, flag: Option<Arc<std::sync::atomic::AtomicBool>>) {
+        self.renderer.set_cancel_flag(flag);
+    }
+
     fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError> {
         scene.validate()?;
         let meshes = scene.meshes.iter().map(PreparedMesh::new).collect();
@@ -99,7 +118,8 @@ impl Backend for CpuBackend {
         let Some((scene, meshes)) = &self.scene else {
             return Err(RenderError::InvalidScene("no scene loaded".into()));
         };
-        self.renderer.resize(view.width, view.height)?;
+        let rows = self.region.clone().unwrap_or(0..view.height);
+        self.renderer.resize_band(view.width, view.height, rows)?;
         let view_projection = view.projection * view.view;
         let lighting = Lighting {
             to_light: view.to_light,
@@ -152,7 +172,7 @@ impl Backend for CpuBackend {
         let fb = self.renderer.framebuffer();
         Ok(FrameImage {
             width: fb.width(),
-            height: fb.height(),
+            height: fb.rows().len() as u32,
             color: fb.try_read_color()?,
             depth: fb.try_read_depth()?,
         })

@@ -96,9 +96,33 @@ impl Renderer {
 
     /// Changes the target size (contents become undefined: clear before drawing).
     pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+        self.resize_band(width, height, 0..height)
+    }
+
+    /// Makes the target rows `rows` of a `width × height` picture (a render region): the
+    /// viewport, snapping and coverage stay those of the whole picture, so the band is
+    /// bit-identical to the same rows of an unbanded frame, but only the 64-row tile rows
+    /// holding `rows` are allocated, binned and drawn, and readback returns `rows` only.
+    /// `rows` must be a non-empty range within `0..height`. Contents become undefined: clear
+    /// before drawing.
+    pub fn resize_band(
+        &mut self,
+        width: u32,
+        height: u32,
+        rows: std::ops::Range<u32>,
+    ) -> Result<(), RenderError> {
         check_target_size(width, height)?;
-        if (width, height) != (self.framebuffer.width(), self.framebuffer.height()) {
-            self.framebuffer = Framebuffer::new(width, height)?;
+        if rows.is_empty() || rows.end > height {
+            return Err(RenderError::InvalidRegion {
+                rows: (rows.start, rows.end),
+                height,
+            });
+        }
+        let fb = &self.framebuffer;
+        if (width, height, rows.clone()) != (fb.width(), fb.height(), fb.rows()) {
+            // Free the old target first: two big targets need not fit at once.
+            self.framebuffer = Framebuffer::new(1, 1)?;
+            self.framebuffer = Framebuffer::band(width, height, rows)?;
         }
         Ok(())
     }
@@ -270,6 +294,11 @@ impl<'a> Frame<'_, 'a> {
         let (strategy, isa) = (*strategy, *isa);
         let budget = FrameBudget::new(start, *timeout, cancel.as_deref());
         pool.install(|| {
+            // A frame cancelled before it began (a big target takes a while to allocate)
+            // skips even the clear.
+            if budget.exhausted() {
+                return;
+            }
             framebuffer.clear(clear_color, clear_depth);
             let viewport = Viewport::new(framebuffer.width(), framebuffer.height());
             let geometry_start = Instant::now();

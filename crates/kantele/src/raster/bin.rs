@@ -7,7 +7,9 @@
 use crate::fixed::{TILE_LOG2, TILE_SIZE};
 use crate::setup::{PixelRect, TriangleSetup};
 
-/// The tiles of a target: `tiles_x × tiles_y` tiles of `TILE_SIZE²` pixels, row-major.
+/// The tiles of a target: `tiles_x × tiles_y` tiles of `TILE_SIZE²` pixels, row-major. A grid
+/// may hold only a band of the target's tile rows (`first_row..first_row + tiles_y`, see
+/// [`TileGrid::band`]); tile indices then count from the band's first tile.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TileGrid {
     /// Target width in pixels.
@@ -16,18 +18,29 @@ pub struct TileGrid {
     pub height: u32,
     /// Tiles per row.
     pub tiles_x: u32,
-    /// Tile rows.
+    /// Tile rows held.
     pub tiles_y: u32,
+    /// The target's first tile row held (0 for a whole target).
+    pub first_row: u32,
 }
 
 impl TileGrid {
     /// The grid covering a `width × height` target.
     pub fn new(width: u32, height: u32) -> Self {
+        Self::band(width, height, 0..height.div_ceil(TILE_SIZE))
+    }
+
+    /// The tile rows `tile_rows` (clamped to the target) of a `width × height` target: the
+    /// viewport stays the whole target's, only these tiles are stored, binned and drawn.
+    pub fn band(width: u32, height: u32, tile_rows: std::ops::Range<u32>) -> Self {
+        let all = height.div_ceil(TILE_SIZE);
+        let first_row = tile_rows.start.min(all);
         Self {
             width,
             height,
             tiles_x: width.div_ceil(TILE_SIZE),
-            tiles_y: height.div_ceil(TILE_SIZE),
+            tiles_y: tile_rows.end.min(all).saturating_sub(first_row),
+            first_row,
         }
     }
 
@@ -39,7 +52,7 @@ impl TileGrid {
     /// The pixels of tile `index`, clipped to the target.
     pub fn tile_rect(&self, index: usize) -> PixelRect {
         let tx = (index % self.tiles_x as usize) as i32;
-        let ty = (index / self.tiles_x as usize) as i32;
+        let ty = (index / self.tiles_x as usize) as i32 + self.first_row as i32;
         let size = TILE_SIZE as i32;
         PixelRect {
             x0: tx * size,
@@ -190,11 +203,19 @@ fn bin_batch(
         let b = tri.bbox;
         let tx0 = (b.x0 >> TILE_LOG2) as usize;
         let tx1 = ((b.x1 - 1) >> TILE_LOG2) as usize;
-        let ty0 = (b.y0 >> TILE_LOG2) as usize;
-        let ty1 = ((b.y1 - 1) >> TILE_LOG2) as usize;
+        // Only the grid's band of tile rows (all of them for a whole target).
+        let (first, end) = (
+            grid.first_row as usize,
+            (grid.first_row + grid.tiles_y) as usize,
+        );
+        let ty0 = ((b.y0 >> TILE_LOG2) as usize).max(first);
+        let ty1 = (((b.y1 - 1) >> TILE_LOG2) as usize).min(end.saturating_sub(1));
+        if ty0 >= end || ty1 < ty0 {
+            continue;
+        }
         let r = TriangleRef::new(batch, index);
         for ty in ty0..=ty1 {
-            let row = ty * grid.tiles_x as usize;
+            let row = (ty - first) * grid.tiles_x as usize;
             for bin in &mut bins[row + tx0..=row + tx1] {
                 bin.push(r);
             }
