@@ -177,7 +177,7 @@ fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
         "no-normals",
         vec![json!({"attributes": {"POSITION": positions, "TEXCOORD_0": texcoords, "COLOR_0": colors}, "indices": indices})],
     );
-    // A strip of the same four vertices (non-indexed) and a points primitive that is skipped.
+    // A strip of the same four vertices (non-indexed) and a points primitive.
     let strip_mesh = g.mesh(
         "strip",
         vec![
@@ -208,16 +208,19 @@ fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
     let eye_center = scene.camera.view.transform_point3(center);
     assert!(eye_center.x.abs() < 1e-3 && eye_center.y.abs() < 1e-3 && eye_center.z < 0.0);
 
-    // Three draws share one mesh; the strip is a second mesh; the points are skipped.
-    assert_eq!(scene.draws.len(), 4);
-    assert_eq!(scene.meshes.len(), 2);
+    // Three draws share one mesh; the strip is a second mesh, the points a third.
+    assert_eq!(scene.draws.len(), 5);
+    assert_eq!(scene.meshes.len(), 3);
+    assert_eq!(scene.meshes[2].topology, kantele::scene::Topology::Points);
+    assert_eq!(scene.meshes[2].indices, vec![0, 1, 2, 3]);
+    assert!(scene.meshes[2].normals.is_none());
     assert!(scene.draws[..3].iter().all(|d| d.mesh == 0));
     assert_eq!(scene.draws[2].node_index, 2);
     assert!(scene.draws[2]
         .model
         .abs_diff_eq(Mat4::from_translation(Vec3::new(4.0, 0.0, 0.0)), 1e-6));
     assert!(
-        info.warnings.iter().any(|w| w.contains("Points")),
+        !info.warnings.iter().any(|w| w.contains("Points")),
         "{:?}",
         info.warnings
     );

@@ -65,6 +65,7 @@ pub fn cube_mesh(material: usize) -> Mesh {
         colors: Some(vec![Vec4::ONE; 24]),
         indices,
         material,
+        topology: kantele::scene::Topology::Triangles,
     }
 }
 

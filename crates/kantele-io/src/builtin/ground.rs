@@ -36,6 +36,7 @@ fn ground_mesh(material: usize) -> Mesh {
         colors: None,
         indices: vec![0, 1, 2, 0, 2, 3],
         material,
+        topology: kantele::scene::Topology::Triangles,
     }
 }
 
@@ -58,6 +59,7 @@ fn triangle_mesh(material: usize) -> Mesh {
         indices: vec![0, 1, 2],
         positions,
         material,
+        topology: kantele::scene::Topology::Triangles,
     }
 }
 

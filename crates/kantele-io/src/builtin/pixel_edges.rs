@@ -57,6 +57,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         colors: Some(colors),
         indices,
         material: 0,
+        topology: kantele::scene::Topology::Triangles,
     };
     let scene = Scene {
         file_cameras: Vec::new(),
