@@ -1,7 +1,9 @@
 //! Clipping of lines and points in homogeneous clip space, by the rules the triangle clipper
 //! follows ([`super::clip`]): segments are cut at the near plane, at a `w` plane relative to the
-//! segment's largest `w` and at the guard band, in `f64` from the exact `f32` inputs, and rounded
-//! to `f32` once; no vertex handed on has `w ≤ 0`. A point is kept only when it lies inside the
+//! segment's largest `w` and at the side planes `|x| ≤ k_x·w`, `|y| ≤ k_y·w` of a
+//! [`GuardBand`], in `f64` from the exact `f32` inputs, and rounded to `f32` once; no vertex
+//! handed on has `w ≤ 0`. The pipeline passes `k = 1`, the view volume's sides, as OpenGL
+//! clips lines (a line leaving the picture then ends on its edge, as in llvmpipe). A point is kept only when it lies inside the
 //! view volume (OpenGL 3.3 §2.20: a point outside it is discarded, not clipped).
 
 use glam::{DVec4, Vec4};

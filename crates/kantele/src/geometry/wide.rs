@@ -29,8 +29,12 @@ use crate::fixed::{snap, SUBPIXEL_HALF, SUBPIXEL_ONE};
 pub struct WideQuad {
     /// Corner positions in window pixels.
     pub corners: [[f32; 2]; 4],
-    /// Vertex each corner takes its attributes from.
+    /// Which end of the quad (0 or 1) each corner belongs to.
     pub ends: [usize; 4],
+    /// Where each end of the quad lies on the primitive, as the parameter `t` of
+    /// `v1 + (v2 − v1)·t` in window space: 0 and 1 unless the diamond-exit rule moved an end
+    /// (then slightly outside or inside [0, 1]); both 0 for a point. Attributes are taken there.
+    pub t: [f32; 2],
 }
 
 impl WideQuad {
@@ -51,6 +55,7 @@ pub fn point_quad(p: [f32; 2]) -> WideQuad {
     WideQuad {
         corners: [[x0, y0], [x1, y0], [x1, y1], [x0, y1]],
         ends: [0; 4],
+        t: [0.0; 2],
     }
 }
 
@@ -180,6 +185,10 @@ pub fn line_quad(v1: [f32; 2], v2: [f32; 2]) -> Option<WideQuad> {
     Some(WideQuad {
         corners: [offset(sa, -1), offset(sb, -1), offset(sb, 1), offset(sa, 1)],
         ends: [0, 1, 1, 0],
+        t: [
+            (a[m] - v1[m]) / (v2[m] - v1[m]),
+            (b[m] - v1[m]) / (v2[m] - v1[m]),
+        ],
     })
 }
 
