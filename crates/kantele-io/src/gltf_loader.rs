@@ -577,7 +577,7 @@ impl Loader<'_> {
         }
     }
 
-    /// The camera of a node, if it has a usable perspective one.
+    /// The camera of a node, if it has a usable (perspective or orthographic) one.
     fn camera(&mut self, node: &gltf::Node, world: Mat4) -> Option<Camera> {
         let camera = node.camera()?;
         let name = named(camera.name(), "camera", camera.index());
@@ -600,14 +600,41 @@ impl Loader<'_> {
                 Some(Camera {
                     view,
                     yfov: p.yfov(),
+                    ymag: None,
                     aspect_ratio: p.aspect_ratio(),
                     znear: p.znear(),
                     zfar: p.zfar(),
                 })
             }
-            gltf::camera::Projection::Orthographic(_) => {
-                self.info.ignore(format!("orthographic camera '{name}'"));
-                None
+            gltf::camera::Projection::Orthographic(o) => {
+                // Pixels stay square: `ymag` is kept and the image's aspect decides the width;
+                // `xmag / ymag` is the aspect an image takes when no size is given.
+                let (xmag, ymag) = (o.xmag().abs(), o.ymag().abs());
+                let ok = xmag.is_finite()
+                    && xmag > 0.0
+                    && ymag.is_finite()
+                    && ymag > 0.0
+                    && o.znear().is_finite()
+                    && o.znear() >= 0.0
+                    && o.zfar().is_finite()
+                    && o.zfar() > o.znear();
+                let view = world.inverse();
+                if !ok || !view.is_finite() {
+                    self.info.warn(format!(
+                        "camera '{name}' has invalid parameters or placement; ignored"
+                    ));
+                    return None;
+                }
+                Some(Camera {
+                    view,
+                    yfov: std::f32::consts::FRAC_PI_4,
+                    ymag: Some(ymag),
+                    aspect_ratio: Some(xmag / ymag),
+                    // glTF allows znear = 0 for orthographic cameras; the pipeline's depth
+                    // range needs a positive one.
+                    znear: o.znear().max(o.zfar() * 1e-6),
+                    zfar: Some(o.zfar()),
+                })
             }
         }
     }

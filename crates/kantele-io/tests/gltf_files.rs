@@ -267,7 +267,7 @@ fn camera_and_light_come_from_the_first_nodes_in_draw_order() {
     // Depth first: root0 → child (first camera, point light), then root1 (second camera).
     let child = g.node(json!({"camera": cam0, "translation": [0.0, 0.0, 5.0], "extensions": {"KHR_lights_punctual": {"light": 0}}}));
     let o = g.node(json!({"camera": ortho}));
-    let root0 = g.node(json!({"children": [o, child], "translation": [1.0, 0.0, 0.0]}));
+    let root0 = g.node(json!({"children": [child, o], "translation": [1.0, 0.0, 0.0]}));
     let root1 =
         g.node(json!({"camera": cam1, "extensions": {"KHR_lights_punctual": {"light": 2}}}));
     let root2 = g.node(json!({"extensions": {"KHR_lights_punctual": {"light": 1}}}));
@@ -304,7 +304,16 @@ fn camera_and_light_come_from_the_first_nodes_in_draw_order() {
             color: Vec3::new(0.0, 3.0, 0.0)
         }
     );
-    assert!(info.warnings.iter().any(|w| w.contains("orthographic")));
+    // The orthographic camera is kept (after the first in draw order): ymag, xmag / ymag.
+    assert!(!info.warnings.iter().any(|w| w.contains("orthographic")));
+    let ortho = scene
+        .file_cameras
+        .iter()
+        .find(|c| c.name == "ortho")
+        .expect("orthographic camera kept");
+    assert_eq!(ortho.camera.ymag, Some(1.0));
+    assert_eq!(ortho.camera.aspect_ratio, Some(1.0));
+    assert_eq!(ortho.camera.zfar, Some(10.0));
     assert!(info.warnings.iter().any(|w| w.contains("point and spot")));
     assert!(scene.materials[0].unlit);
     assert_eq!(scene.materials[0].alpha_mode, AlphaMode::Blend);

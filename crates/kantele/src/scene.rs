@@ -196,13 +196,17 @@ pub struct NamedCamera {
     pub camera: Camera,
 }
 
-/// A perspective camera: placement plus glTF-style projection parameters.
+/// A perspective or orthographic camera: placement plus glTF-style projection parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// World → eye transform (inverse of the camera node's world matrix).
     pub view: Mat4,
-    /// Vertical field of view in radians.
+    /// Vertical field of view in radians (perspective cameras).
     pub yfov: f32,
+    /// `Some(ymag)`: an orthographic camera whose view volume is `2·ymag` scene units high (and
+    /// `2·ymag·aspect` wide; glTF's `xmag / ymag` is its `aspect_ratio`); `yfov` is then unused
+    /// and `zfar` must be finite.
+    pub ymag: Option<f32>,
     /// Width / height; `None` means the render target's aspect.
     pub aspect_ratio: Option<f32>,
     /// Near plane distance (> 0).
@@ -216,6 +220,11 @@ impl Camera {
     /// none of its own).
     pub fn projection(&self, target_aspect: f32) -> Mat4 {
         let aspect = self.aspect_ratio.unwrap_or(target_aspect);
+        if let Some(ymag) = self.ymag {
+            let xmag = ymag * aspect;
+            let far = self.zfar.unwrap_or(self.znear + 1.0);
+            return Mat4::orthographic_rh_gl(-xmag, xmag, -ymag, ymag, self.znear, far);
+        }
         match self.zfar {
             Some(far) => camera::perspective(self.yfov, aspect, self.znear, far),
             None => camera::perspective_infinite(self.yfov, aspect, self.znear),
@@ -248,6 +257,7 @@ impl Camera {
         Self {
             view: camera::look_at(eye, center, up),
             yfov,
+            ymag: None,
             aspect_ratio: None,
             znear: (distance - radius).max(distance * 1e-3) * 0.5,
             zfar: Some(distance + radius * 2.0),

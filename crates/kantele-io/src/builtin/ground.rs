@@ -121,6 +121,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         camera: Camera {
             view: camera::look_at(eye, Vec3::new(0.0, 1.0, -20.0), Vec3::Y),
             yfov: 60f32.to_radians(),
+            ymag: None,
             aspect_ratio: None,
             znear: 0.1,
             zfar: None,
