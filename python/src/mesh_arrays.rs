@@ -237,6 +237,7 @@ pub fn scene_from_arrays(arrays: &MeshArrays<'_>, double_sided: bool) -> PyResul
         colors,
         indices,
         material: 0,
+        ..Mesh::default()
     });
     scene.draws.push(Draw {
         mesh: 0,

@@ -91,12 +91,23 @@ pub struct CameraPlan {
     radius: Option<f32>,
     up: UpAxis,
     yfov: f32,
+    /// `--ortho`: the automatic framing is orthographic.
+    ortho: bool,
 }
 
 impl CameraPlan {
     /// Parses the camera flags and reads `--views` (sizes there win over `size`).
     pub fn new(args: &CameraArgs, size: Option<(u32, u32)>) -> Result<Self> {
         let spec = args.camera.as_deref().map(parse_camera).transpose()?;
+        if args.ortho && !matches!(spec, None | Some(CameraSpec::Auto)) {
+            bail!("--ortho frames the model itself: it combines only with --camera auto");
+        }
+        // `--ortho` is the automatic framing, whatever cameras the file has.
+        let spec = if args.ortho {
+            Some(CameraSpec::Auto)
+        } else {
+            spec
+        };
         let views = args
             .views
             .as_ref()
@@ -127,6 +138,7 @@ impl CameraPlan {
                 UpArg::Z => UpAxis::Z,
             },
             yfov: args.fov.unwrap_or(DEFAULT_YFOV_DEG).to_radians(),
+            ortho: args.ortho,
         })
     }
 
@@ -260,8 +272,12 @@ impl CameraPlan {
             AUTO_AZIMUTH_DEG.to_radians(),
             AUTO_ELEVATION_DEG.to_radians(),
         );
-        CameraPose::frame_bounds(bounds, dir.as_vec3(), self.up, self.yfov, width, height)
-            .map_err(|e| anyhow!("{label}: camera: {}", e.0))
+        let pose = if self.ortho {
+            CameraPose::frame_bounds_orthographic(bounds, dir.as_vec3(), self.up, width, height)
+        } else {
+            CameraPose::frame_bounds(bounds, dir.as_vec3(), self.up, self.yfov, width, height)
+        };
+        pose.map_err(|e| anyhow!("{label}: camera: {}", e.0))
     }
 }
 
@@ -338,13 +354,47 @@ mod tests {
 
     #[test]
     fn auto_framing_keeps_the_model_inside_and_large() {
+        for ortho in [false, true] {
+            auto_framing_case(ortho);
+        }
+    }
+
+    #[test]
+    fn ortho_combines_only_with_auto() {
+        let args = |camera: Option<&str>| CameraArgs {
+            camera: camera.map(str::to_string),
+            ortho: true,
+            ..Default::default()
+        };
+        assert!(CameraPlan::new(&args(Some("0")), None).is_err());
+        assert!(CameraPlan::new(&args(Some("look-at:0,0,5:0,0,0")), None).is_err());
+        // Without --camera it frames the model even where the file has a camera.
+        let loaded = cube();
+        assert!(loaded.info.camera_from_file);
+        let plan = CameraPlan::new(&args(None), None).unwrap();
+        let pose = &plan.poses(&loaded, 64, 48, "cube").unwrap()[0];
+        assert!(matches!(
+            pose.projection,
+            kantele_io::pose::Projection::Orthographic { .. }
+        ));
+    }
+
+    fn auto_framing_case(ortho: bool) {
         let loaded = cube();
         let args = CameraArgs {
             camera: Some("auto".into()),
+            ortho,
             ..Default::default()
         };
         let plan = CameraPlan::new(&args, None).unwrap();
         let pose = &plan.poses(&loaded, 200, 100, "cube").unwrap()[0];
+        assert_eq!(
+            matches!(
+                pose.projection,
+                kantele_io::pose::Projection::Orthographic { .. }
+            ),
+            ortho
+        );
         let b = Bounds::of_scene(&loaded.scene).unwrap();
         let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
         for c in b.corners() {

@@ -240,6 +240,10 @@ pub struct CameraArgs {
     /// Vertical field of view in degrees of `auto`, `look-at` and orbit cameras (default 45).
     #[arg(long, value_name = "DEG", value_parser = parse_fov)]
     pub fov: Option<f32>,
+    /// Frame the bounding box with an orthographic camera (the `auto` framing, from the same
+    /// direction; implies `--camera auto`, which is the only camera it combines with).
+    #[arg(long, conflicts_with_all = ["fov", "views", "orbit"])]
+    pub ortho: bool,
     /// Render the views of a file: a sidecar written by `render` (reproduces its picture) or a
     /// list of poses (see --help).
     #[arg(long, value_name = "FILE", conflicts_with = "orbit")]

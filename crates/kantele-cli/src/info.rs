@@ -81,6 +81,7 @@ pub fn describe(loaded: &LoadedScene) -> Value {
         "camera": {
             "from_file": info.camera_from_file,
             "yfov": cam.yfov,
+            "ymag": cam.ymag,
             "aspect_ratio": cam.aspect_ratio,
             "znear": cam.znear,
             "zfar": cam.zfar,

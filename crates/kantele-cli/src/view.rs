@@ -77,6 +77,7 @@ impl Orbit {
         Camera {
             view: kantele::camera::look_at(eye, self.center, Vec3::Y),
             yfov: self.yfov,
+            ymag: None,
             aspect_ratio: None,
             znear: (self.distance - self.radius).max(self.distance * 1e-3) * 0.5,
             zfar: Some(self.distance + self.radius * 2.0),

@@ -66,19 +66,32 @@ fn write_triangle_soup(path: &Path, n: usize) {
 #[test]
 fn views_file_reproduces_the_sidecar_picture() {
     let dir = TempDir::new("views");
-    for camera in ["look-at:2.5,1.5,3:0,0,0", "auto"] {
-        let o = kantele(&[
+    for camera in [
+        &["--camera", "look-at:2.5,1.5,3:0,0,0"][..],
+        &["--camera", "auto"],
+        &["--ortho"],
+    ] {
+        let a_png = dir.s("a.png");
+        let mut args = vec![
             "render",
             "--builtin",
             "teapot",
             "--size",
             "90x60",
-            "--camera",
-            camera,
             "-o",
-            &dir.s("a.png"),
-        ]);
+            &a_png,
+        ];
+        args.extend_from_slice(camera);
+        let o = kantele(&args);
         ok(&o);
+        let side: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(dir.path("a.png.json")).unwrap()).unwrap();
+        let model = side["camera"]["model"].as_str();
+        assert_eq!(
+            model == Some("orthographic"),
+            camera == ["--ortho"],
+            "{camera:?}: {model:?}"
+        );
         let o = kantele(&[
             "render",
             "--builtin",
@@ -91,7 +104,7 @@ fn views_file_reproduces_the_sidecar_picture() {
         ok(&o);
         let a = std::fs::read(dir.path("a.png")).unwrap();
         let b = std::fs::read(dir.path("b.png")).unwrap();
-        assert!(a == b, "{camera}: the views file gives another picture");
+        assert!(a == b, "{camera:?}: the views file gives another picture");
         let side: serde_json::Value =
             serde_json::from_slice(&std::fs::read(dir.path("b.png.json")).unwrap()).unwrap();
         assert_eq!(

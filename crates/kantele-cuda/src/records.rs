@@ -334,7 +334,8 @@ impl SceneArrays {
                 vertex_base,
                 vertices.len() as u32,
                 index_base,
-                (indices.len() / 3) as u32,
+                // Lines and points are not drawn by this backend (yet): no triangles.
+                mesh.triangle_count() as u32,
             ));
             out.vertices.extend_from_slice(&vertices);
             out.indices.extend_from_slice(&indices);

@@ -79,7 +79,7 @@ use glam::{Mat3, Mat4, Vec4};
 use glow::HasContext;
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::camera::normal_matrix;
-use kantele::scene::{AlphaMode, Scene};
+use kantele::scene::{AlphaMode, Scene, Topology};
 use kantele::stats::FrameStats;
 use kantele::RenderError;
 
@@ -423,13 +423,17 @@ impl GlBackend {
             gl.uniform_1_i32(u.emissive_texture.as_ref(), 1);
             gl.active_texture(glow::TEXTURE0);
 
+            // Points and lines are drawn with GL's initial point size and line width, 1 (never
+            // changed here; PROGRAM_POINT_SIZE stays off), as the CPU pipeline draws them.
+            gl.line_width(1.0);
+            let unlit = scene.unlit_materials();
             for draw_index in scene.draw_order(&view.view) {
                 let draw = &scene.draws[draw_index];
                 let mesh = &scene.meshes[draw.mesh];
                 let gpu_mesh = &self.gpu.meshes[draw.mesh];
-                let material = &scene.materials[mesh.material];
+                let material = scene.draw_material(draw.mesh, &unlit);
                 stats.draws += 1;
-                stats.triangles_in += mesh.triangle_count() as u64;
+                stats.triangles_in += mesh.primitive_count() as u64;
                 if gpu_mesh.index_count == 0 {
                     continue;
                 }
@@ -510,7 +514,12 @@ impl GlBackend {
                     }
                 }
                 gl.bind_vertex_array(Some(gpu_mesh.vertex_array));
-                gl.draw_elements(glow::TRIANGLES, gpu_mesh.index_count, glow::UNSIGNED_INT, 0);
+                let mode = match mesh.topology {
+                    Topology::Triangles => glow::TRIANGLES,
+                    Topology::Lines => glow::LINES,
+                    Topology::Points => glow::POINTS,
+                };
+                gl.draw_elements(mode, gpu_mesh.index_count, glow::UNSIGNED_INT, 0);
             }
             gl.bind_vertex_array(None);
             gl.depth_mask(true);

@@ -58,6 +58,7 @@ fn rect(x0: f32, y0: f32, x1: f32, y1: f32, z: f32, material: usize) -> Mesh {
         colors: None,
         indices: vec![0, 1, 2, 0, 2, 3],
         material,
+        ..Mesh::default()
     }
 }
 

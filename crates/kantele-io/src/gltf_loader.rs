@@ -8,7 +8,7 @@ use glam::{Mat3, Mat4, Quat, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use kantele::scene::{
-    AlphaMode, Camera, Draw, Light, Material, Mesh, NamedCamera, Scene, TextureBinding,
+    AlphaMode, Camera, Draw, Light, Material, Mesh, NamedCamera, Scene, TextureBinding, Topology,
 };
 use kantele::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 
@@ -16,7 +16,8 @@ use crate::accessor::{read_f32, read_u32, BufferData};
 use crate::budget::Budget;
 use crate::gltf_patch::{patch, split_glb, Patched};
 use crate::mesh_util::{
-    fan_to_list, first_index_out_of_range, flat_normals, framing_camera, strip_to_list,
+    fan_to_list, first_index_out_of_range, flat_normals, framing_camera, line_strip_to_list,
+    strip_to_list,
 };
 use crate::read_policy::{read_regular_file, ReadPolicy};
 use crate::texture_util::{decode_srgb_within, image_size, placeholder, ImageError};
@@ -576,7 +577,7 @@ impl Loader<'_> {
         }
     }
 
-    /// The camera of a node, if it has a usable perspective one.
+    /// The camera of a node, if it has a usable (perspective or orthographic) one.
     fn camera(&mut self, node: &gltf::Node, world: Mat4) -> Option<Camera> {
         let camera = node.camera()?;
         let name = named(camera.name(), "camera", camera.index());
@@ -599,14 +600,41 @@ impl Loader<'_> {
                 Some(Camera {
                     view,
                     yfov: p.yfov(),
+                    ymag: None,
                     aspect_ratio: p.aspect_ratio(),
                     znear: p.znear(),
                     zfar: p.zfar(),
                 })
             }
-            gltf::camera::Projection::Orthographic(_) => {
-                self.info.ignore(format!("orthographic camera '{name}'"));
-                None
+            gltf::camera::Projection::Orthographic(o) => {
+                // Pixels stay square: `ymag` is kept and the image's aspect decides the width;
+                // `xmag / ymag` is the aspect an image takes when no size is given.
+                let (xmag, ymag) = (o.xmag().abs(), o.ymag().abs());
+                let ok = xmag.is_finite()
+                    && xmag > 0.0
+                    && ymag.is_finite()
+                    && ymag > 0.0
+                    && o.znear().is_finite()
+                    && o.znear() >= 0.0
+                    && o.zfar().is_finite()
+                    && o.zfar() > o.znear();
+                let view = world.inverse();
+                if !ok || !view.is_finite() {
+                    self.info.warn(format!(
+                        "camera '{name}' has invalid parameters or placement; ignored"
+                    ));
+                    return None;
+                }
+                Some(Camera {
+                    view,
+                    yfov: std::f32::consts::FRAC_PI_4,
+                    ymag: Some(ymag),
+                    aspect_ratio: Some(xmag / ymag),
+                    // glTF allows znear = 0 for orthographic cameras; the pipeline's depth
+                    // range needs a positive one.
+                    znear: o.znear().max(o.zfar() * 1e-6),
+                    zfar: Some(o.zfar()),
+                })
             }
         }
     }
@@ -811,7 +839,7 @@ impl Loader<'_> {
         })
     }
 
-    /// Converts one primitive to a scene mesh; `None` when it is not drawn (points, lines).
+    /// Converts one primitive (triangles, lines or points) to a scene mesh.
     fn primitive(
         &mut self,
         mesh: &gltf::Mesh,
@@ -821,15 +849,6 @@ impl Loader<'_> {
         let mesh_name = named(mesh.name(), "mesh", mesh.index());
         let what = format!("mesh '{mesh_name}' primitive {}", primitive.index());
         let mode = primitive.mode();
-        if !matches!(
-            mode,
-            Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan
-        ) {
-            self.info.warn(format!(
-                "{what}: mode {mode:?} is not drawn (only triangles are)"
-            ));
-            return Ok(None);
-        }
         let material = match primitive.material().index() {
             Some(m) => m,
             None => self.default_material(),
@@ -1016,17 +1035,27 @@ impl Loader<'_> {
                 "{what}: some positions are infinite or NaN; triangles using them are not drawn"
             ));
         }
-        let indices = match mode {
-            Mode::TriangleStrip => strip_to_list(&vertex_indices),
-            Mode::TriangleFan => fan_to_list(&vertex_indices),
-            _ => {
-                if vertex_indices.len() % 3 != 0 {
+        let (indices, topology) = match mode {
+            Mode::TriangleStrip => (strip_to_list(&vertex_indices), Topology::Triangles),
+            Mode::TriangleFan => (fan_to_list(&vertex_indices), Topology::Triangles),
+            Mode::LineStrip => (line_strip_to_list(&vertex_indices, false), Topology::Lines),
+            Mode::LineLoop => (line_strip_to_list(&vertex_indices, true), Topology::Lines),
+            Mode::Points => (vertex_indices, Topology::Points),
+            Mode::Lines | Mode::Triangles => {
+                let topology = if mode == Mode::Lines {
+                    Topology::Lines
+                } else {
+                    Topology::Triangles
+                };
+                let per = topology.vertices_per_primitive();
+                if vertex_indices.len() % per != 0 {
                     return Err(self.invalid(format!(
-                        "{what}: {} indices do not make whole triangles",
-                        vertex_indices.len()
+                        "{what}: {} indices do not make whole {}",
+                        vertex_indices.len(),
+                        topology.name()
                     )));
                 }
-                vertex_indices
+                (vertex_indices, topology)
             }
         };
         if let Some((position, index)) = first_index_out_of_range(&indices, n) {
@@ -1041,9 +1070,10 @@ impl Loader<'_> {
             texcoords,
             colors,
             indices,
+            topology,
             material,
         };
-        if converted.normals.is_none() {
+        if converted.normals.is_none() && topology == Topology::Triangles {
             // De-indexed: one vertex (position, normal, texcoord, colour) per corner.
             self.budget
                 .charge(converted.indices.len() as u64, 48, &what)

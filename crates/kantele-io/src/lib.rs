@@ -47,6 +47,7 @@ pub mod mesh_util;
 mod meshopt_views;
 mod obj_loader;
 mod obj_text;
+mod obj_wide;
 pub mod output;
 pub mod pose;
 mod quiet_panic;

@@ -54,6 +54,23 @@ pub fn fan_to_list(fan: &[u32]) -> Vec<u32> {
     list
 }
 
+/// Converts a line strip (`LINE_STRIP`) or, with `closed`, a line loop (`LINE_LOOP`) to a list
+/// of segments: `(v[i], v[i + 1])`, plus `(v[last], v[0])` for a loop. Fewer than two vertices
+/// make no segment.
+pub fn line_strip_to_list(strip: &[u32], closed: bool) -> Vec<u32> {
+    if strip.len() < 2 {
+        return Vec::new();
+    }
+    let mut list = Vec::with_capacity(strip.len() * 2);
+    for w in strip.windows(2) {
+        list.extend([w[0], w[1]]);
+    }
+    if closed {
+        list.extend([strip[strip.len() - 1], strip[0]]);
+    }
+    list
+}
+
 /// The first index that is out of range, as `(position, index)`.
 pub fn first_index_out_of_range(indices: &[u32], vertex_count: usize) -> Option<(usize, u32)> {
     indices
@@ -96,6 +113,7 @@ mod tests {
             colors: Some(vec![Vec4::ONE, Vec4::X, Vec4::Y, Vec4::Z]),
             indices: vec![0, 1, 2, 0, 2, 3],
             material: 0,
+            topology: kantele::scene::Topology::Triangles,
         }
     }
 
@@ -151,5 +169,12 @@ mod tests {
         assert_eq!(fan_to_list(&[0, 1, 2, 3]), vec![0, 1, 2, 0, 2, 3]);
         assert!(strip_to_list(&[0, 1]).is_empty());
         assert!(fan_to_list(&[]).is_empty());
+    }
+
+    #[test]
+    fn line_strips_and_loops_become_segments() {
+        assert_eq!(line_strip_to_list(&[4, 5, 6], false), vec![4, 5, 5, 6]);
+        assert_eq!(line_strip_to_list(&[4, 5, 6], true), vec![4, 5, 5, 6, 6, 4]);
+        assert!(line_strip_to_list(&[4], true).is_empty());
     }
 }

@@ -6,13 +6,14 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use kantele::scene::{AlphaMode, Draw, Light, Material, Mesh, Scene, TextureBinding};
+use kantele::scene::{AlphaMode, Draw, Light, Material, Mesh, Scene, TextureBinding, Topology};
 use kantele::shade::texture::Texture;
 
 use crate::budget::Budget;
 use crate::ear_clip::triangulate;
 use crate::mesh_util::{first_index_out_of_range, flat_normals, framing_camera};
 use crate::obj_text::{patch_mtl, patch_obj, text, texture_file_name, UNNAMED_MATERIAL};
+use crate::obj_wide::{read_lines_points, ObjWide};
 use crate::read_policy::{read_regular_file, ReadPolicy};
 use crate::texture_util::{
     decode_srgb_within, image_size, placeholder, trilinear_repeat, ImageError,
@@ -38,8 +39,11 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
             "parsing the OBJ text",
         )
         .map_err(|e| LoadError::invalid(path, e))?;
-    let patched = patch_obj(&text(&bytes));
+    let source = text(&bytes);
     drop(bytes);
+    let patched = patch_obj(&source);
+    let wide = (patched.lines + patched.points > 0).then(|| read_lines_points(&source));
+    drop(source);
     let policy = ReadPolicy::new(path, &options.allow_read);
     let directory = path.parent().unwrap_or(Path::new("")).to_path_buf();
     // The MTL loader runs inside tobj (a `Fn`): what it needs to change goes through cells.
@@ -89,12 +93,6 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     };
     for w in mtl_warnings.into_inner() {
         info.warn(w);
-    }
-    if patched.lines > 0 {
-        info.ignore(format!("{} line statements (l)", patched.lines));
-    }
-    if patched.points > 0 {
-        info.ignore(format!("{} point statements (p)", patched.points));
     }
     let mut scene = Scene {
         light: Light::Headlight,
@@ -250,6 +248,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
             texcoords,
             colors,
             indices,
+            topology: Topology::Triangles,
             material,
         };
         if mesh.normals.is_none() {
@@ -267,14 +266,78 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
             node_index: model_index,
         });
     }
+    if let Some(wide) = wide {
+        add_lines_points(
+            &mut scene,
+            &mut info,
+            wide,
+            &materials,
+            &mut default_material,
+        );
+    }
     if scene.draws.is_empty() {
-        info.warn("the file has no faces: nothing is drawn");
+        info.warn("the file has no faces, lines or points: nothing is drawn");
     }
     scene.camera = framing_camera(&scene);
     scene
         .validate()
         .map_err(|e| LoadError::invalid(path, e.to_string()))?;
     Ok(LoadedScene { scene, info })
+}
+
+/// Adds a mesh and a draw for each group of `l` / `p` statements, with only the positions it
+/// uses; its material is the `usemtl` in force (by name), else the default one.
+fn add_lines_points(
+    scene: &mut Scene,
+    info: &mut SceneInfo,
+    wide: ObjWide,
+    materials: &[tobj::Material],
+    default_material: &mut Option<usize>,
+) {
+    for w in wide.warnings {
+        info.warn(w);
+    }
+    for (k, group) in wide.groups.into_iter().enumerate() {
+        let named = group.material.as_ref().and_then(|name| {
+            materials
+                .iter()
+                .position(|m| &m.name == name)
+                .filter(|&i| i < scene.materials.len())
+        });
+        let material = named.unwrap_or_else(|| {
+            *default_material.get_or_insert_with(|| {
+                scene.materials.push(Material::default());
+                scene.materials.len() - 1
+            })
+        });
+        let mut remap: HashMap<u32, u32> = HashMap::new();
+        let mut positions = Vec::new();
+        let indices = group
+            .indices
+            .iter()
+            .map(|&i| {
+                *remap.entry(i).or_insert_with(|| {
+                    positions.push(wide.positions[i as usize]);
+                    positions.len() as u32 - 1
+                })
+            })
+            .collect();
+        let name = format!("{} {k}", group.topology.name());
+        scene.meshes.push(Mesh {
+            name: name.clone(),
+            positions,
+            indices,
+            topology: group.topology,
+            material,
+            ..Mesh::default()
+        });
+        scene.draws.push(Draw {
+            mesh: scene.meshes.len() - 1,
+            model: Mat4::IDENTITY,
+            node_name: name,
+            node_index: info.node_count + k,
+        });
+    }
 }
 
 /// Reads and decodes a texture file under the read policy and budget (a placeholder when

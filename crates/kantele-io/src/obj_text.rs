@@ -1,8 +1,8 @@
 //! OBJ and MTL text made safe for `tobj`, which panics or fails on some valid or harmless
 //! input: bytes that are not UTF-8 are read as Latin-1, one-value colour lines (`Kd 0.8`) are
 //! widened, malformed colour lines are dropped with a warning, empty material names get a
-//! name, and `l` / `p` lines (lines and points, which are not drawn) are taken out instead of
-//! being read as faces.
+//! name, and `l` / `p` lines (lines and points) are taken out instead of being read as faces
+//! (`obj_wide` reads them).
 
 /// The name given to materials declared with an empty `newmtl` (and used by an empty
 /// `usemtl`); reported as an empty name.

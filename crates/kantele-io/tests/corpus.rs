@@ -270,17 +270,7 @@ fn quantized_positions_draw_like_floats() {
 }
 
 #[test]
-fn lines_and_points_are_not_drawn_as_triangles_and_nan_warns() {
-    let mut g = quad_scene(json!({}));
-    g.json["meshes"][0]["primitives"][0]["mode"] = json!(1); // LINES
-    let loaded = load(&write(&g, "lines"));
-    assert_eq!(coverage(&render(&loaded.scene, Pass::Color)), 0);
-    assert!(
-        loaded.info.warnings.iter().any(|w| w.contains("not drawn")),
-        "{:?}",
-        loaded.info.warnings
-    );
-
+fn nan_positions_warn() {
     let mut g = Gltf::new();
     let p = g.vec3(&[
         [0.0, 0.0, 0.0],
@@ -504,4 +494,131 @@ fn realworld_files_render_with_their_properties() {
         bright(&lit),
         bright(&unlit)
     );
+}
+
+/// Renders the scene as the CLI does (`kantele_io::pose`: pixels square, the image's aspect
+/// wins) with its file camera at [`SIZE`].
+fn render_posed(scene: &Scene) -> FrameImage {
+    let pose = kantele_io::pose::CameraPose::from_scene_camera(&scene.camera, SIZE.0, SIZE.1)
+        .expect("usable camera");
+    let scene = Arc::new(scene.clone());
+    let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu backend");
+    cpu.load(scene.clone()).expect("load");
+    cpu.render(&pose.frame_view(&scene, Pass::Color))
+        .expect("render");
+    cpu.read_frame().expect("read")
+}
+
+/// Drawn pixels as `(x, y)`.
+fn drawn_pixels(image: &FrameImage) -> Vec<(u32, u32)> {
+    (0..image.width * image.height)
+        .filter(|&i| image.depth[i as usize] < 1.0)
+        .map(|i| (i % image.width, i / image.width))
+        .collect()
+}
+
+/// An orthographic camera at z = 5 looking down −z whose view volume maps one scene unit to one
+/// pixel at [`SIZE`] (ymag = 60 for 120 rows; xmag follows the image's aspect), and one mesh of
+/// the given primitives (no normals: drawn unlit, white).
+fn pixel_grid_scene(primitive: serde_json::Value) -> Gltf {
+    let mut g = Gltf::new();
+    let mesh = g.mesh("wide", vec![primitive]);
+    let node = g.node(json!({"mesh": mesh}));
+    g.root(node);
+    let cam = g.camera(json!({"type": "orthographic", "orthographic": {"xmag": 80.0, "ymag": 60.0, "znear": 1.0, "zfar": 10.0}}));
+    let cam_node = g.node(json!({"camera": cam, "translation": [0.0, 0.0, 5.0]}));
+    g.root(cam_node);
+    g
+}
+
+/// Scene position of the centre of pixel `(x, y)` on the [`pixel_grid_scene`] camera.
+fn pixel_centre(x: u32, y: u32) -> [f32; 3] {
+    let (w, h) = (SIZE.0 as f32, SIZE.1 as f32);
+    [x as f32 + 0.5 - w / 2.0, h / 2.0 - (y as f32 + 0.5), 0.0]
+}
+
+#[test]
+fn a_gltf_line_covers_one_pixel_per_column_and_a_point_one_pixel() {
+    // LINES from the centre of pixel (10, 49) to that of (140, 29): the start pixel's diamond
+    // is left (drawn), the end's only entered (not drawn): columns 10..140, one pixel each.
+    let mut g = pixel_grid_scene(json!({"attributes": {"POSITION": 0}, "mode": 1}));
+    g.vec3(&[pixel_centre(10, 49), pixel_centre(140, 29)]);
+    let loaded = load(&write(&g, "gltf-line"));
+    assert_eq!(
+        loaded.scene.meshes[0].topology,
+        kantele::scene::Topology::Lines
+    );
+    let image = render_posed(&loaded.scene);
+    let pixels = drawn_pixels(&image);
+    assert_eq!(pixels.len(), 130, "{pixels:?}");
+    let columns: std::collections::BTreeSet<u32> = pixels.iter().map(|p| p.0).collect();
+    assert_eq!(columns, (10..140).collect(), "one pixel per column");
+    assert!(pixels.contains(&(10, 49)) && pixels.contains(&(139, 29)));
+    // Unlit white (no normals), not the ambient-only grey a lit line would get.
+    let c = pixel(&image, 10, 49);
+    assert!(c.truncate().min_element() > 0.99, "{c}");
+
+    // POINTS: a point a quarter pixel off the centre of pixel (80, 59) draws that pixel only.
+    let mut g = pixel_grid_scene(json!({"attributes": {"POSITION": 0}, "mode": 0}));
+    let [x, y, z] = pixel_centre(80, 59);
+    g.vec3(&[[x + 0.25, y - 0.25, z], [x - 30.0, y + 20.0, z]]);
+    let loaded = load(&write(&g, "gltf-points"));
+    let pixels = drawn_pixels(&render_posed(&loaded.scene));
+    assert_eq!(pixels, vec![(50, 39), (80, 59)]);
+}
+
+#[test]
+fn every_primitive_mode_draws_something() {
+    // A square outline / its corners in each of glTF's seven modes (as the sample models
+    // `Mesh_PrimitiveMode_*` do): none may come out black.
+    for mode in 0..=6u32 {
+        let mut g = pixel_grid_scene(json!({"attributes": {"POSITION": 0}, "mode": mode}));
+        // Corners on pixel centres (80 ± 30.5, 60 ± 30.5 in window pixels).
+        let s = 30.5;
+        let corners = [[-s, -s, 0.0], [s, -s, 0.0], [s, s, 0.0], [-s, s, 0.0]];
+        let positions: Vec<[f32; 3]> = match mode {
+            1 => vec![
+                corners[0], corners[1], corners[1], corners[2], corners[2], corners[3], corners[3],
+                corners[0],
+            ],
+            4 => vec![
+                corners[0], corners[1], corners[2], corners[0], corners[2], corners[3],
+            ],
+            5 => vec![corners[0], corners[1], corners[3], corners[2]],
+            _ => corners.to_vec(),
+        };
+        g.vec3(&positions);
+        let loaded = load(&write(&g, &format!("mode-{mode}")));
+        assert!(
+            loaded.info.warnings.is_empty(),
+            "mode {mode}: {:?}",
+            loaded.info.warnings
+        );
+        let drawn = drawn_pixels(&render_posed(&loaded.scene)).len();
+        let want = match mode {
+            0 => 4,       // points
+            1 | 2 => 244, // four sides of 61 pixels, each corner drawn once (by the side leaving it)
+            3 => 183,     // an open strip: three sides, its last corner not drawn
+            _ => 3721,    // a filled 61 × 61 square
+        };
+        assert_eq!(drawn, want, "mode {mode}");
+    }
+}
+
+#[test]
+fn an_orthographic_square_stays_square() {
+    // A 2 × 2 quad seen by an orthographic camera whose own xmag / ymag is 2: the image's
+    // aspect (4:3) wins and ymag is kept, so the quad is 60 × 60 pixels, not stretched.
+    let mut g = quad_scene(json!({"extensions": {"KHR_materials_unlit": {}}}));
+    g.json["cameras"][0] = json!({"type": "orthographic", "orthographic": {"xmag": 4.0, "ymag": 2.0, "znear": 0.1, "zfar": 10.0}});
+    let loaded = load(&write(&g, "ortho-square"));
+    assert_eq!(loaded.scene.camera.ymag, Some(2.0));
+    let pixels = drawn_pixels(&render_posed(&loaded.scene));
+    let span = |f: fn(&(u32, u32)) -> u32| {
+        let lo = pixels.iter().map(f).min().unwrap_or(0);
+        let hi = pixels.iter().map(f).max().unwrap_or(0);
+        hi + 1 - lo
+    };
+    assert_eq!((span(|p| p.0), span(|p| p.1)), (60, 60));
+    assert_eq!(pixels.len(), 3600);
 }

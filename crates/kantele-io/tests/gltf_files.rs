@@ -177,7 +177,7 @@ fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
         "no-normals",
         vec![json!({"attributes": {"POSITION": positions, "TEXCOORD_0": texcoords, "COLOR_0": colors}, "indices": indices})],
     );
-    // A strip of the same four vertices (non-indexed) and a points primitive that is skipped.
+    // A strip of the same four vertices (non-indexed) and a points primitive.
     let strip_mesh = g.mesh(
         "strip",
         vec![
@@ -208,16 +208,19 @@ fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
     let eye_center = scene.camera.view.transform_point3(center);
     assert!(eye_center.x.abs() < 1e-3 && eye_center.y.abs() < 1e-3 && eye_center.z < 0.0);
 
-    // Three draws share one mesh; the strip is a second mesh; the points are skipped.
-    assert_eq!(scene.draws.len(), 4);
-    assert_eq!(scene.meshes.len(), 2);
+    // Three draws share one mesh; the strip is a second mesh, the points a third.
+    assert_eq!(scene.draws.len(), 5);
+    assert_eq!(scene.meshes.len(), 3);
+    assert_eq!(scene.meshes[2].topology, kantele::scene::Topology::Points);
+    assert_eq!(scene.meshes[2].indices, vec![0, 1, 2, 3]);
+    assert!(scene.meshes[2].normals.is_none());
     assert!(scene.draws[..3].iter().all(|d| d.mesh == 0));
     assert_eq!(scene.draws[2].node_index, 2);
     assert!(scene.draws[2]
         .model
         .abs_diff_eq(Mat4::from_translation(Vec3::new(4.0, 0.0, 0.0)), 1e-6));
     assert!(
-        info.warnings.iter().any(|w| w.contains("Points")),
+        !info.warnings.iter().any(|w| w.contains("Points")),
         "{:?}",
         info.warnings
     );
@@ -264,7 +267,7 @@ fn camera_and_light_come_from_the_first_nodes_in_draw_order() {
     // Depth first: root0 → child (first camera, point light), then root1 (second camera).
     let child = g.node(json!({"camera": cam0, "translation": [0.0, 0.0, 5.0], "extensions": {"KHR_lights_punctual": {"light": 0}}}));
     let o = g.node(json!({"camera": ortho}));
-    let root0 = g.node(json!({"children": [o, child], "translation": [1.0, 0.0, 0.0]}));
+    let root0 = g.node(json!({"children": [child, o], "translation": [1.0, 0.0, 0.0]}));
     let root1 =
         g.node(json!({"camera": cam1, "extensions": {"KHR_lights_punctual": {"light": 2}}}));
     let root2 = g.node(json!({"extensions": {"KHR_lights_punctual": {"light": 1}}}));
@@ -301,7 +304,16 @@ fn camera_and_light_come_from_the_first_nodes_in_draw_order() {
             color: Vec3::new(0.0, 3.0, 0.0)
         }
     );
-    assert!(info.warnings.iter().any(|w| w.contains("orthographic")));
+    // The orthographic camera is kept (after the first in draw order): ymag, xmag / ymag.
+    assert!(!info.warnings.iter().any(|w| w.contains("orthographic")));
+    let ortho = scene
+        .file_cameras
+        .iter()
+        .find(|c| c.name == "ortho")
+        .expect("orthographic camera kept");
+    assert_eq!(ortho.camera.ymag, Some(1.0));
+    assert_eq!(ortho.camera.aspect_ratio, Some(1.0));
+    assert_eq!(ortho.camera.zfar, Some(10.0));
     assert!(info.warnings.iter().any(|w| w.contains("point and spot")));
     assert!(scene.materials[0].unlit);
     assert_eq!(scene.materials[0].alpha_mode, AlphaMode::Blend);

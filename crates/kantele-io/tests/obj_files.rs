@@ -116,7 +116,7 @@ fn obj_without_mtl_uses_the_default_material() {
 }
 
 /// Real-world OBJ details (issue 9): texture paths relative to the MTL's folder, one-value
-/// colours, Latin-1 names, empty material names, concave faces, `l` lines, malformed MTL lines.
+/// colours, Latin-1 names, empty material names, concave faces, `l` lines (kept as line meshes), malformed MTL lines.
 #[test]
 fn real_world_obj_details() {
     let dir = temp_dir("obj-real");
@@ -176,7 +176,16 @@ fn real_world_obj_details() {
         .sum();
     assert!((area - 3.0).abs() < 1e-5, "area {area}");
     assert_eq!(scene.triangle_count(), 6);
-    assert!(warnings.contains("line statements"), "{warnings}");
+    // The `l 1 2 3` polyline: two segments under the material in force, with its positions.
+    let line = scene
+        .meshes
+        .iter()
+        .find(|m| m.topology == kantele::scene::Topology::Lines)
+        .expect("a line mesh");
+    assert_eq!(line.indices, vec![0, 1, 1, 2]);
+    assert_eq!(line.positions[2], glam::Vec3::new(1.0, 2.0, 0.0));
+    assert_eq!(scene.materials[line.material].name, "wood");
+    assert!(line.normals.is_none(), "lines keep no made-up normals");
 }
 
 /// A huge polygon is refused by the budget before it is parsed.

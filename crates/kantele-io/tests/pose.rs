@@ -157,6 +157,7 @@ fn intrinsics_and_projection_round_trip() {
     let camera = kantele::scene::Camera {
         view: Mat4::IDENTITY,
         yfov: 0.9,
+        ymag: None,
         aspect_ratio: Some(3.0),
         znear: 0.1,
         zfar: None,

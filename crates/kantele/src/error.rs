@@ -58,6 +58,9 @@ pub enum RenderError {
     /// The index buffer does not hold whole triangles.
     #[error("index count {0} is not a multiple of 3")]
     IncompleteTriangle(usize),
+    /// The index buffer of a line draw does not hold whole segments (an odd count).
+    #[error("index count {0} of a line draw is not a multiple of 2")]
+    IncompleteLine(usize),
     /// A vertex shader declared more varyings than the pipeline carries.
     #[error("shader declares {0} varyings, at most {max} are supported", max = crate::MAX_VARYINGS)]
     TooManyVaryings(usize),

@@ -10,8 +10,10 @@ use crate::camera;
 use crate::error::RenderError;
 use crate::setup::FrontFace;
 use crate::shade::texture::{Sampler, Texture};
+pub use crate::state::Topology;
 
-/// An indexed triangle list with the standard vertex attributes.
+/// An indexed list of triangles, lines or points ([`Mesh::topology`]) with the standard vertex
+/// attributes.
 #[derive(Clone, Debug, Default)]
 pub struct Mesh {
     /// Name for reports (glTF mesh name, OBJ object name); may be empty.
@@ -24,22 +26,40 @@ pub struct Mesh {
     pub texcoords: Option<Vec<Vec2>>,
     /// Linear vertex colours (`COLOR_0`), RGBA, one per position.
     pub colors: Option<Vec<Vec4>>,
-    /// Triangle list: three indices per triangle.
+    /// Index list: three indices per triangle, two per line, one per point.
     pub indices: Vec<u32>,
+    /// What the indices describe (strips, fans and loops are unrolled by the loaders).
+    pub topology: Topology,
     /// Index into [`Scene::materials`].
     pub material: usize,
 }
 
 impl Mesh {
-    /// Number of triangles.
+    /// Number of triangles (0 for a mesh of lines or points).
     pub fn triangle_count(&self) -> usize {
-        self.indices.len() / 3
+        match self.topology {
+            Topology::Triangles => self.indices.len() / 3,
+            _ => 0,
+        }
+    }
+
+    /// Number of primitives: triangles, lines or points.
+    pub fn primitive_count(&self) -> usize {
+        self.indices.len() / self.topology.vertices_per_primitive()
     }
 
     /// The mesh with one vertex per triangle corner and every normal set to its face normal
     /// `normalize((b − a) × (c − a))` (object space; counter-clockwise faces point outwards).
-    /// Zero-area faces get +Z. Used for meshes without normals.
+    /// Zero-area faces get +Z. Used for meshes without normals. Lines and points have no
+    /// faces: they keep their vertices and get +Z normals (backends draw them unlit, as glTF
+    /// asks for lines and points without normals).
     pub fn flat_shaded(&self) -> Mesh {
+        if self.topology != Topology::Triangles {
+            return Mesh {
+                normals: Some(vec![Vec3::Z; self.positions.len()]),
+                ..self.clone()
+            };
+        }
         let n = self.indices.len();
         let mut out = Mesh {
             name: self.name.clone(),
@@ -48,6 +68,7 @@ impl Mesh {
             texcoords: self.texcoords.as_ref().map(|_| Vec::with_capacity(n)),
             colors: self.colors.as_ref().map(|_| Vec::with_capacity(n)),
             indices: (0..n as u32).collect(),
+            topology: Topology::Triangles,
             material: self.material,
         };
         let get = |i: u32| self.positions.get(i as usize).copied().unwrap_or(Vec3::NAN);
@@ -175,13 +196,17 @@ pub struct NamedCamera {
     pub camera: Camera,
 }
 
-/// A perspective camera: placement plus glTF-style projection parameters.
+/// A perspective or orthographic camera: placement plus glTF-style projection parameters.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
     /// World → eye transform (inverse of the camera node's world matrix).
     pub view: Mat4,
-    /// Vertical field of view in radians.
+    /// Vertical field of view in radians (perspective cameras).
     pub yfov: f32,
+    /// `Some(ymag)`: an orthographic camera whose view volume is `2·ymag` scene units high (and
+    /// `2·ymag·aspect` wide; glTF's `xmag / ymag` is its `aspect_ratio`); `yfov` is then unused
+    /// and `zfar` must be finite.
+    pub ymag: Option<f32>,
     /// Width / height; `None` means the render target's aspect.
     pub aspect_ratio: Option<f32>,
     /// Near plane distance (> 0).
@@ -195,6 +220,11 @@ impl Camera {
     /// none of its own).
     pub fn projection(&self, target_aspect: f32) -> Mat4 {
         let aspect = self.aspect_ratio.unwrap_or(target_aspect);
+        if let Some(ymag) = self.ymag {
+            let xmag = ymag * aspect;
+            let far = self.zfar.unwrap_or(self.znear + 1.0);
+            return Mat4::orthographic_rh_gl(-xmag, xmag, -ymag, ymag, self.znear, far);
+        }
         match self.zfar {
             Some(far) => camera::perspective(self.yfov, aspect, self.znear, far),
             None => camera::perspective_infinite(self.yfov, aspect, self.znear),
@@ -227,6 +257,7 @@ impl Camera {
         Self {
             view: camera::look_at(eye, center, up),
             yfov,
+            ymag: None,
             aspect_ratio: None,
             znear: (distance - radius).max(distance * 1e-3) * 0.5,
             zfar: Some(distance + radius * 2.0),
@@ -354,6 +385,29 @@ impl Scene {
         order
     }
 
+    /// Unlit copies of the materials, for lines and points without normals: glTF 2.0 §3.7.2.1
+    /// says they are drawn without lighting. Index `i` is material `i` with `unlit` set.
+    pub fn unlit_materials(&self) -> Vec<Material> {
+        self.materials
+            .iter()
+            .map(|m| Material {
+                unlit: true,
+                ..m.clone()
+            })
+            .collect()
+    }
+
+    /// The material mesh `mesh` is drawn with: its own, or its unlit copy from `unlit`
+    /// ([`Scene::unlit_materials`]) for lines and points without normals.
+    pub fn draw_material<'s>(&'s self, mesh: usize, unlit: &'s [Material]) -> &'s Material {
+        let mesh = &self.meshes[mesh];
+        if mesh.topology != Topology::Triangles && mesh.normals.is_none() {
+            &unlit[mesh.material]
+        } else {
+            &self.materials[mesh.material]
+        }
+    }
+
     /// World-space bounding sphere `(center, radius)` of everything drawn (from the boxes).
     pub fn bounding_sphere(&self) -> Option<(Vec3, f32)> {
         let mut lo = Vec3::splat(f32::INFINITY);
@@ -411,8 +465,14 @@ impl Scene {
                     "mesh {i}: attribute count differs from its {n} positions"
                 )));
             }
-            if mesh.indices.len() % 3 != 0 {
-                return Err(RenderError::IncompleteTriangle(mesh.indices.len()));
+            match mesh.topology {
+                Topology::Triangles if mesh.indices.len() % 3 != 0 => {
+                    return Err(RenderError::IncompleteTriangle(mesh.indices.len()))
+                }
+                Topology::Lines if mesh.indices.len() % 2 != 0 => {
+                    return Err(RenderError::IncompleteLine(mesh.indices.len()))
+                }
+                _ => {}
             }
             if let Some((position, &index)) = mesh
                 .indices

@@ -217,6 +217,18 @@ pub fn setup_triangle(
     for i in 0..3 {
         (window[i], inv_w[i]) = viewport.to_window(pos_clip[i]);
     }
+    setup_window_triangle(viewport, window, inv_w, cull, front_face)
+}
+
+/// [`setup_triangle`] from window coordinates `(x, y, depth)` and `1/w` of each vertex (points
+/// and lines are expanded into triangles in window space, `geometry::wide`).
+pub fn setup_window_triangle(
+    viewport: &Viewport,
+    window: [[f32; 3]; 3],
+    mut inv_w: [f32; 3],
+    cull: CullMode,
+    front_face: FrontFace,
+) -> Result<TriangleSetup, SetupReject> {
     let mut pos: [[i64; 2]; 3] = [
         [snap(window[0][0]), snap(window[0][1])],
         [snap(window[1][0]), snap(window[1][1])],

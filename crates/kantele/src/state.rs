@@ -161,6 +161,39 @@ impl BlendMode {
     }
 }
 
+/// What a draw's indices describe: OpenGL's primitive modes after strips, fans and loops are
+/// unrolled into lists (glTF `TRIANGLES`, `LINES`, `POINTS`; OBJ `f`, `l`, `p`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, Hash)]
+pub enum Topology {
+    /// Three indices per triangle.
+    #[default]
+    Triangles,
+    /// Two indices per line segment, drawn 1 pixel wide by OpenGL's rules.
+    Lines,
+    /// One index per point, drawn as the 1 × 1 pixel square centred on it.
+    Points,
+}
+
+impl Topology {
+    /// Indices per primitive: 3, 2 or 1.
+    pub fn vertices_per_primitive(self) -> usize {
+        match self {
+            Topology::Triangles => 3,
+            Topology::Lines => 2,
+            Topology::Points => 1,
+        }
+    }
+
+    /// The lower-case name (`triangles`, `lines`, `points`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Topology::Triangles => "triangles",
+            Topology::Lines => "lines",
+            Topology::Points => "points",
+        }
+    }
+}
+
 /// Fixed-function state of a draw.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RenderState {

@@ -65,6 +65,7 @@ pub fn cube_mesh(material: usize) -> Mesh {
         colors: Some(vec![Vec4::ONE; 24]),
         indices,
         material,
+        topology: kantele::scene::Topology::Triangles,
     }
 }
 
@@ -74,6 +75,7 @@ fn thesis_camera(view: Mat4) -> Camera {
     Camera {
         view,
         yfov: 2.0 * (0.25f32 / 0.5).atan(),
+        ymag: None,
         aspect_ratio: None,
         znear: 0.5,
         zfar: Some(100.0),

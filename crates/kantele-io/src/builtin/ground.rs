@@ -36,6 +36,7 @@ fn ground_mesh(material: usize) -> Mesh {
         colors: None,
         indices: vec![0, 1, 2, 0, 2, 3],
         material,
+        topology: kantele::scene::Topology::Triangles,
     }
 }
 
@@ -58,6 +59,7 @@ fn triangle_mesh(material: usize) -> Mesh {
         indices: vec![0, 1, 2],
         positions,
         material,
+        topology: kantele::scene::Topology::Triangles,
     }
 }
 
@@ -119,6 +121,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         camera: Camera {
             view: camera::look_at(eye, Vec3::new(0.0, 1.0, -20.0), Vec3::Y),
             yfov: 60f32.to_radians(),
+            ymag: None,
             aspect_ratio: None,
             znear: 0.1,
             zfar: None,

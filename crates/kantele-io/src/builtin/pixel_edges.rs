@@ -57,6 +57,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         colors: Some(colors),
         indices,
         material: 0,
+        topology: kantele::scene::Topology::Triangles,
     };
     let scene = Scene {
         file_cameras: Vec::new(),
@@ -76,6 +77,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         camera: Camera {
             view: Mat4::IDENTITY,
             yfov: 2.0 * 0.5f32.atan(),
+            ymag: None,
             aspect_ratio: Some(WIDTH as f32 / HEIGHT as f32),
             znear: 0.1,
             zfar: Some(10.0),

@@ -113,6 +113,7 @@ pub fn teapot_mesh(material: usize) -> Mesh {
         colors: None,
         indices,
         material,
+        topology: kantele::scene::Topology::Triangles,
     }
 }
 

@@ -259,6 +259,79 @@ impl CameraPose {
         )
     }
 
+    /// An orthographic camera that looks at `bounds` from direction `from_dir` (centre towards
+    /// the eye) and makes the box fill the picture as [`CameraPose::frame_bounds`] does: the
+    /// box's projection centred and spanning [`FRAMING_FILL`] of the image along its tighter
+    /// direction (`ymag` chosen for that; pixels stay square). The eye sits one radius in front
+    /// of the box and the depth range holds all of it.
+    pub fn frame_bounds_orthographic(
+        bounds: &Bounds,
+        from_dir: Vec3,
+        up: UpAxis,
+        width: u32,
+        height: u32,
+    ) -> Result<Self, PoseError> {
+        let aspect = check_size(width, height)?;
+        if !bounds.min.is_finite() || !bounds.max.is_finite() {
+            return Err(err("the bounds to frame are not finite"));
+        }
+        let back = unit(from_dir.as_dvec3())
+            .ok_or_else(|| err(format!("framing direction {from_dir} is not a direction")))?;
+        let up_hint = if back.cross(up.vector()).length_squared() < 1e-12 {
+            if back.cross(DVec3::Z).length_squared() < 1e-12 {
+                DVec3::Y
+            } else {
+                DVec3::Z
+            }
+        } else {
+            up.vector()
+        };
+        let right = up_hint.cross(back).normalize();
+        let cam_up = back.cross(right);
+        let scale = bounds.scale();
+        let center = bounds.center();
+        let corners = bounds.corners().map(|p| {
+            let q = (p - center) / scale;
+            DVec3::new(q.dot(right), q.dot(cam_up), q.dot(back))
+        });
+        let fold = |f: fn(&DVec3) -> f64, pick: fn(f64, f64) -> f64, start: f64| {
+            corners.iter().map(f).fold(start, pick)
+        };
+        let (lo_x, hi_x) = (
+            fold(|c| c.x, f64::min, f64::MAX),
+            fold(|c| c.x, f64::max, f64::MIN),
+        );
+        let (lo_y, hi_y) = (
+            fold(|c| c.y, f64::min, f64::MAX),
+            fold(|c| c.y, f64::max, f64::MIN),
+        );
+        let (lo_z, hi_z) = (
+            fold(|c| c.z, f64::min, f64::MAX),
+            fold(|c| c.z, f64::max, f64::MIN),
+        );
+        let half_x = 0.5 * (hi_x - lo_x);
+        let half_y = 0.5 * (hi_y - lo_y);
+        let ymag = (half_y.max(half_x / aspect) / FRAMING_FILL).max(1e-6);
+        let (sx, sy) = (0.5 * (lo_x + hi_x), 0.5 * (lo_y + hi_y));
+        // The eye one radius (in box units) in front of the nearest corner.
+        let distance = hi_z + 1.0;
+        let target = center + (right * sx + cam_up * sy) * scale;
+        let eye = target + back * (distance * scale);
+        let view = look_at_f64(eye, target, up.vector())?;
+        let near = 0.5 * scale;
+        let far = (distance - lo_z + 1.0) * scale;
+        CameraPose::new(
+            width,
+            height,
+            Projection::Orthographic {
+                ymag: (ymag * scale) as f32,
+            },
+            near as f32,
+            Some(far as f32),
+            view,
+        )
+    }
+
     /// `n` perspective cameras on a circle around the centre of `bounds`, all looking at it:
     /// at `elevation_deg` above the horizon of `up`, azimuths `360° · k / n` from the front
     /// (see [`UpAxis::direction`]), `radius` from the centre, or when `None` far enough that

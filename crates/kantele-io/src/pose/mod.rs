@@ -250,13 +250,18 @@ impl CameraPose {
         })
     }
 
-    /// The scene file's camera at `width × height`: its view, `yfov` and depth range. Its
-    /// `aspect_ratio` is ignored (pixels stay square; the image's aspect wins).
+    /// The scene file's camera at `width × height`: its view, `yfov` (or `ymag` for an
+    /// orthographic camera) and depth range. Its `aspect_ratio` is ignored (pixels stay square;
+    /// the image's aspect wins).
     pub fn from_scene_camera(camera: &Camera, width: u32, height: u32) -> Result<Self, PoseError> {
+        let projection = match camera.ymag {
+            Some(ymag) => Projection::Orthographic { ymag },
+            None => Projection::Perspective { yfov: camera.yfov },
+        };
         Self::new(
             width,
             height,
-            Projection::Perspective { yfov: camera.yfov },
+            projection,
             camera.znear,
             camera.zfar,
             camera.view,

@@ -8,7 +8,7 @@ use crate::error::RenderError;
 use crate::material::{Lighting, MaterialShader, StandardVertex};
 use crate::pipeline::{Indices, RenderState, Renderer, RendererOptions};
 use crate::raster::Strategy;
-use crate::scene::{Mesh, Scene};
+use crate::scene::{Mesh, Scene, Topology};
 use crate::stats::FrameStats;
 
 /// Options of the CPU backend.
@@ -18,12 +18,17 @@ pub type CpuOptions = RendererOptions;
 struct PreparedMesh {
     vertices: Vec<StandardVertex>,
     indices: Vec<u32>,
+    topology: Topology,
 }
 
 impl PreparedMesh {
     fn new(mesh: &Mesh) -> Self {
         let (vertices, indices) = StandardVertex::from_mesh(mesh);
-        Self { vertices, indices }
+        Self {
+            vertices,
+            indices,
+            topology: mesh.topology,
+        }
     }
 }
 
@@ -126,12 +131,13 @@ impl Backend for CpuBackend {
             light_color: view.light_color,
             ambient: scene.ambient,
         };
+        let unlit = scene.unlit_materials();
         let shaders: Vec<MaterialShader<'_>> = scene
             .draws
             .iter()
             .enumerate()
             .map(|(i, draw)| {
-                let material = &scene.materials[scene.meshes[draw.mesh].material];
+                let material = scene.draw_material(draw.mesh, &unlit);
                 let texture = material
                     .base_color_texture
                     .map(|b| (&*scene.textures[b.texture], b.sampler));
@@ -163,7 +169,13 @@ impl Backend for CpuBackend {
                 front_face: draw.front_face(),
                 ..shader.render_state()
             };
-            frame.draw(shader, &mesh.vertices, Indices::U32(&mesh.indices), state)?;
+            frame.draw_primitives(
+                shader,
+                &mesh.vertices,
+                Indices::U32(&mesh.indices),
+                mesh.topology,
+                state,
+            )?;
         }
         frame.try_end()
     }

@@ -11,7 +11,7 @@ use crate::raster::BlockCoverage;
 use crate::rop::{DepthFunc, TileBuffer};
 use crate::setup::{setup_triangle, SetupReject, TriangleSetup, Viewport};
 use crate::simd::Isa;
-use crate::state::RenderState;
+use crate::state::{RenderState, Topology};
 use crate::MAX_VARYINGS;
 
 /// An index buffer.
@@ -49,7 +49,8 @@ impl Indices<'_> {
 pub(super) trait DrawJob: Sync {
     fn vertex_count(&self) -> usize;
     fn varying_count(&self) -> usize;
-    fn triangle_count(&self) -> usize;
+    /// Triangles, lines or points, by the draw's topology.
+    fn primitive_count(&self) -> usize;
     fn shade_vertices(&self, first: usize, pos: &mut [Vec4], varyings: &mut [f32]);
     /// Whether a triangle of this draw wholly behind a tile's depth bound can be skipped there:
     /// the test is LESS or LEQUAL (its fragments would all fail, and shaders have no side
@@ -80,6 +81,7 @@ pub(super) struct DrawCall<'a, S: Shader> {
     pub(super) shader: &'a S,
     pub(super) vertices: &'a [S::Vertex],
     pub(super) indices: Indices<'a>,
+    pub(super) topology: Topology,
     pub(super) state: RenderState,
 }
 
@@ -129,8 +131,8 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
         self.shader.varying_count()
     }
 
-    fn triangle_count(&self) -> usize {
-        self.indices.len(self.vertices.len()) / 3
+    fn primitive_count(&self) -> usize {
+        self.indices.len(self.vertices.len()) / self.topology.vertices_per_primitive()
     }
 
     fn shade_vertices(&self, first: usize, pos: &mut [Vec4], varyings: &mut [f32]) {
@@ -150,7 +152,7 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
     }
 
     fn sort_order(&self, shaded: &ShadedVertices) -> Option<Vec<u32>> {
-        if !self.state.sort_back_to_front {
+        if !self.state.sort_back_to_front || self.topology != Topology::Triangles {
             return None;
         }
         let key = |t: usize| {
@@ -162,7 +164,7 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
                 w
             }
         };
-        let mut order: Vec<u32> = (0..self.triangle_count() as u32).collect();
+        let mut order: Vec<u32> = (0..self.primitive_count() as u32).collect();
         // Farthest first; a stable sort keeps submission order among equals.
         order.sort_by(|&a, &b| key(b as usize).total_cmp(&key(a as usize)));
         Some(order)
@@ -177,6 +179,9 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
         target: &TargetSpace,
         out: &mut PrimitiveBatch,
     ) {
+        if self.topology != Topology::Triangles {
+            return self.assemble_points_lines(draw, triangles, shaded, target, out);
+        }
         let TargetSpace { viewport, guard } = target;
         let n = self.shader.varying_count();
         for slot in triangles {

@@ -194,7 +194,7 @@ pub(super) fn run_geometry(
         .map(|(d, s)| d.sort_order(s))
         .collect();
     for (draw, d) in draws.iter().enumerate() {
-        let count = d.triangle_count();
+        let count = d.primitive_count();
         let mut first = 0;
         while first < count {
             let last = (first + PRIMITIVE_CHUNK).min(count);

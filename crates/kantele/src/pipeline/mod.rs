@@ -17,6 +17,7 @@ mod budget;
 mod draw;
 mod fragment;
 mod geometry;
+mod points_lines;
 mod sanitize;
 mod shader;
 
@@ -28,7 +29,7 @@ use glam::Vec4;
 
 pub use self::draw::Indices;
 pub use self::shader::{FnShader, Fragment, FragmentLanes, ShadedLanes, Shader};
-pub use crate::state::RenderState;
+pub use crate::state::{RenderState, Topology};
 
 use self::budget::FrameBudget;
 use self::draw::{DrawCall, DrawJob};
@@ -221,8 +222,9 @@ pub struct Frame<'r, 'a> {
 }
 
 impl<'a> Frame<'_, 'a> {
-    /// Queues a draw of `indices` (or of the vertices in order) from `vertices` with `shader`
-    /// and `state`. Checks the buffers now; nothing is drawn until [`Frame::end`].
+    /// Queues a draw of the triangles `indices` (or the vertices in order) describe, from
+    /// `vertices` with `shader` and `state`. Checks the buffers now; nothing is drawn until
+    /// [`Frame::end`].
     pub fn draw<S: Shader>(
         &mut self,
         shader: &'a S,
@@ -230,13 +232,31 @@ impl<'a> Frame<'_, 'a> {
         indices: Indices<'a>,
         state: RenderState,
     ) -> Result<(), RenderError> {
+        self.draw_primitives(shader, vertices, indices, Topology::Triangles, state)
+    }
+
+    /// [`Frame::draw`] for any [`Topology`]: lines are drawn 1 pixel wide and points as one
+    /// pixel, by OpenGL's rules (never culled, always front-facing; see
+    /// [`crate::geometry::wide`]).
+    pub fn draw_primitives<S: Shader>(
+        &mut self,
+        shader: &'a S,
+        vertices: &'a [S::Vertex],
+        indices: Indices<'a>,
+        topology: Topology,
+        state: RenderState,
+    ) -> Result<(), RenderError> {
         let n = shader.varying_count();
         if n > MAX_VARYINGS {
             return Err(RenderError::TooManyVaryings(n));
         }
         let count = indices.len(vertices.len());
-        if count % 3 != 0 {
-            return Err(RenderError::IncompleteTriangle(count));
+        match topology {
+            Topology::Triangles if count % 3 != 0 => {
+                return Err(RenderError::IncompleteTriangle(count))
+            }
+            Topology::Lines if count % 2 != 0 => return Err(RenderError::IncompleteLine(count)),
+            _ => {}
         }
         let out_of_range = |ix: usize| ix >= vertices.len();
         let bad = match indices {
@@ -251,7 +271,8 @@ impl<'a> Frame<'_, 'a> {
                 vertex_count: vertices.len(),
             });
         }
-        let batches = self.batches + (count / 3).div_ceil(geometry::PRIMITIVE_CHUNK);
+        let primitives = count / topology.vertices_per_primitive();
+        let batches = self.batches + primitives.div_ceil(geometry::PRIMITIVE_CHUNK);
         if batches > crate::raster::bin::TriangleRef::MAX_BATCHES {
             return Err(RenderError::FrameTooLarge);
         }
@@ -260,6 +281,7 @@ impl<'a> Frame<'_, 'a> {
             shader,
             vertices,
             indices,
+            topology,
             state,
         }));
         Ok(())
