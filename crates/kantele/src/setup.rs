@@ -139,11 +139,35 @@ pub struct TriangleSetup {
     pub draw: u32,
     /// Index of the source triangle within its draw.
     pub primitive_id: u32,
-    /// Whether the triangle is front-facing.
-    pub front_facing: bool,
-    /// Whether vertices 1 and 2 were swapped to make the area positive (varyings follow).
-    pub swapped: bool,
+    /// Bit set of [`TriangleSetup::FRONT_FACING`] and [`TriangleSetup::SWAPPED`] (a `u32`, not
+    /// `bool`s, so a GPU reads the same bytes; other bits are 0).
+    pub flags: u32,
+    /// Always 0: makes the record's end explicit (no compiler padding; the size is a multiple
+    /// of 8 for the `i64` fields).
+    pub reserved: u32,
 }
+
+/// The record's size and field offsets, fixed: the CUDA backend's kernels mirror them
+/// (`kantele-cuda/kernels/common.cuh`, checked again on the device at start-up).
+const _: () = {
+    use std::mem::{offset_of, size_of};
+    type T = TriangleSetup;
+    assert!(size_of::<EdgeFunction>() == 32);
+    assert!(size_of::<PixelRect>() == 16);
+    assert!(offset_of!(T, edges) == 0);
+    assert!(offset_of!(T, area2) == 96);
+    assert!(offset_of!(T, bbox) == 104);
+    assert!(offset_of!(T, pos_subpixel) == 120);
+    assert!(offset_of!(T, depth) == 168);
+    assert!(offset_of!(T, depth_range) == 180);
+    assert!(offset_of!(T, inv_w) == 188);
+    assert!(offset_of!(T, bary_gradient) == 200);
+    assert!(offset_of!(T, draw) == 216);
+    assert!(offset_of!(T, primitive_id) == 220);
+    assert!(offset_of!(T, flags) == 224);
+    assert!(offset_of!(T, reserved) == 228);
+    assert!(size_of::<T>() == 232);
+};
 
 /// Why setup produced no triangle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -292,12 +316,31 @@ pub fn setup_triangle(
         ],
         draw: 0,
         primitive_id: 0,
-        front_facing,
-        swapped,
+        flags: (front_facing as u32 * TriangleSetup::FRONT_FACING)
+            | (swapped as u32 * TriangleSetup::SWAPPED),
+        reserved: 0,
     })
 }
 
 impl TriangleSetup {
+    /// [`TriangleSetup::flags`] bit: the triangle is front-facing.
+    pub const FRONT_FACING: u32 = 1;
+    /// [`TriangleSetup::flags`] bit: vertices 1 and 2 were swapped to make the area positive
+    /// (varyings follow).
+    pub const SWAPPED: u32 = 2;
+
+    /// Whether the triangle is front-facing.
+    #[inline]
+    pub fn front_facing(&self) -> bool {
+        self.flags & Self::FRONT_FACING != 0
+    }
+
+    /// Whether vertices 1 and 2 were swapped to make the area positive (varyings follow).
+    #[inline]
+    pub fn swapped(&self) -> bool {
+        self.flags & Self::SWAPPED != 0
+    }
+
     /// Whether the centre of pixel `(x, y)` is covered (top-left rule included).
     #[inline]
     pub fn covers(&self, x: i32, y: i32) -> bool {
@@ -351,7 +394,9 @@ mod tests {
         let vp = Viewport::new(16, 16);
         let ccw = [ndc(-0.5, -0.5), ndc(0.5, -0.5), ndc(0.0, 0.5)];
         let t = setup_triangle(&vp, ccw, CullMode::Back, FrontFace::Ccw).expect("front face");
-        assert!(t.front_facing);
+        assert!(t.front_facing());
+        // Counter-clockwise in NDC is clockwise with window y down: set up swapped.
+        assert!(t.swapped());
         assert!(t.area2 > 0);
         let cw = [ccw[0], ccw[2], ccw[1]];
         assert_eq!(
@@ -359,7 +404,9 @@ mod tests {
             Err(SetupReject::Culled)
         );
         let back = setup_triangle(&vp, cw, CullMode::None, FrontFace::Ccw).expect("not culled");
-        assert!(!back.front_facing);
+        assert!(!back.front_facing());
+        assert!(!back.swapped());
+        assert_eq!(back.flags, 0);
         assert_eq!(
             setup_triangle(&vp, ccw, CullMode::Front, FrontFace::Ccw),
             Err(SetupReject::Culled)

@@ -108,7 +108,7 @@ impl<S: Shader> DrawCall<'_, S> {
             Ok(mut tri) => {
                 tri.draw = draw;
                 tri.primitive_id = primitive_id;
-                let order = if tri.swapped { [0, 2, 1] } else { [0, 1, 2] };
+                let order = if tri.swapped() { [0, 2, 1] } else { [0, 1, 2] };
                 for v in order {
                     out.attrs.extend_from_slice(varyings[v]);
                 }
