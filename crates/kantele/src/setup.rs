@@ -229,6 +229,34 @@ impl Viewport {
     }
 }
 
+/// One vertex in window space, as setup reads it: snapped sub-pixel position, window depth and
+/// `1 / w_clip`. Computed once per vertex ([`Viewport::window_vertex`]) and shared by every
+/// triangle that uses the vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct WindowVertex {
+    /// Snapped position in sub-pixel units ([`snap`]: within ±`SUBPIXEL_LIMIT`).
+    pub pos: [i32; 2],
+    /// Window depth `(z/w + 1) / 2`.
+    pub depth: f32,
+    /// `1 / w_clip`.
+    pub inv_w: f32,
+}
+
+impl Viewport {
+    /// The window-space vertex of a clip-space position (meaningful for `w > 0` inside the
+    /// guard band; any input gives a defined value).
+    #[inline]
+    pub fn window_vertex(&self, pos_clip: Vec4) -> WindowVertex {
+        let (window, inv_w) = self.to_window(pos_clip);
+        // `snap` clamps to ±SUBPIXEL_LIMIT = ±2^24: the value fits an `i32`.
+        WindowVertex {
+            pos: [snap(window[0]) as i32, snap(window[1]) as i32],
+            depth: window[2],
+            inv_w,
+        }
+    }
+}
+
 /// Sets up one triangle from clip-space positions (each with `w > 0`, inside the guard band).
 pub fn setup_triangle(
     viewport: &Viewport,
@@ -236,18 +264,30 @@ pub fn setup_triangle(
     cull: CullMode,
     front_face: FrontFace,
 ) -> Result<TriangleSetup, SetupReject> {
-    let mut window = [[0.0f32; 3]; 3];
-    let mut inv_w = [0.0f32; 3];
-    for i in 0..3 {
-        (window[i], inv_w[i]) = viewport.to_window(pos_clip[i]);
-    }
-    let mut pos: [[i64; 2]; 3] = [
-        [snap(window[0][0]), snap(window[0][1])],
-        [snap(window[1][0]), snap(window[1][1])],
-        [snap(window[2][0]), snap(window[2][1])],
+    let window = [
+        viewport.window_vertex(pos_clip[0]),
+        viewport.window_vertex(pos_clip[1]),
+        viewport.window_vertex(pos_clip[2]),
     ];
-    let mut area2 = (pos[1][0] - pos[0][0]) * (pos[2][1] - pos[0][1])
-        - (pos[2][0] - pos[0][0]) * (pos[1][1] - pos[0][1]);
+    setup_window_triangle(viewport, window, cull, front_face)
+}
+
+/// Sets up one triangle from its window-space vertices ([`Viewport::window_vertex`] of positions
+/// with `w > 0` inside the guard band): the same record as [`setup_triangle`].
+#[inline]
+pub fn setup_window_triangle(
+    viewport: &Viewport,
+    window: [WindowVertex; 3],
+    cull: CullMode,
+    front_face: FrontFace,
+) -> Result<TriangleSetup, SetupReject> {
+    let [v0, mut v1, mut v2] = window;
+    let area = |v0: &WindowVertex, v1: &WindowVertex, v2: &WindowVertex| {
+        let p0 = [v0.pos[0] as i64, v0.pos[1] as i64];
+        (v1.pos[0] as i64 - p0[0]) * (v2.pos[1] as i64 - p0[1])
+            - (v2.pos[0] as i64 - p0[0]) * (v1.pos[1] as i64 - p0[1])
+    };
+    let mut area2 = area(&v0, &v1, &v2);
     if area2 == 0 {
         return Err(SetupReject::Degenerate);
     }
@@ -261,28 +301,29 @@ pub fn setup_triangle(
         (CullMode::Back, false) | (CullMode::Front, true) => return Err(SetupReject::Culled),
         _ => {}
     }
-    let mut depth = [window[0][2], window[1][2], window[2][2]];
     let swapped = area2 < 0;
     if swapped {
-        pos.swap(1, 2);
-        depth.swap(1, 2);
-        inv_w.swap(1, 2);
+        std::mem::swap(&mut v1, &mut v2);
         area2 = -area2;
     }
+    let v = [v0, v1, v2];
+    let pos: [[i64; 2]; 3] = v.map(|v| [v.pos[0] as i64, v.pos[1] as i64]);
     let p = |i: usize| (pos[i][0], pos[i][1]);
     let edges = [
         EdgeFunction::new(p(1), p(2)),
         EdgeFunction::new(p(2), p(0)),
         EdgeFunction::new(p(0), p(1)),
     ];
-    // Pixel x is a candidate when its centre x·256 + 128 lies within [min, max].
-    let min_x = pos.iter().map(|v| v[0]).min().unwrap_or(0);
-    let max_x = pos.iter().map(|v| v[0]).max().unwrap_or(0);
-    let min_y = pos.iter().map(|v| v[1]).min().unwrap_or(0);
-    let max_y = pos.iter().map(|v| v[1]).max().unwrap_or(0);
-    let first =
-        |min: i64| (min - crate::fixed::SUBPIXEL_HALF + SUBPIXEL_ONE - 1).div_euclid(SUBPIXEL_ONE);
-    let last = |max: i64| (max - crate::fixed::SUBPIXEL_HALF).div_euclid(SUBPIXEL_ONE);
+    // Pixel x is a candidate when its centre x·256 + 128 lies within [min, max]; an arithmetic
+    // shift is the floor division by 256.
+    let min_x = pos[0][0].min(pos[1][0]).min(pos[2][0]);
+    let max_x = pos[0][0].max(pos[1][0]).max(pos[2][0]);
+    let min_y = pos[0][1].min(pos[1][1]).min(pos[2][1]);
+    let max_y = pos[0][1].max(pos[1][1]).max(pos[2][1]);
+    let half = crate::fixed::SUBPIXEL_HALF;
+    let bits = crate::fixed::SUBPIXEL_BITS;
+    let first = |min: i64| (min - half + SUBPIXEL_ONE - 1) >> bits;
+    let last = |max: i64| (max - half) >> bits;
     let bbox = PixelRect {
         x0: first(min_x) as i32,
         y0: first(min_y) as i32,
@@ -293,6 +334,8 @@ pub fn setup_triangle(
     if bbox.is_empty() {
         return Err(SetupReject::Degenerate);
     }
+    let depth = [v0.depth, v1.depth, v2.depth];
+    let area_f = area2 as f32;
     Ok(TriangleSetup {
         edges,
         area2,
@@ -303,16 +346,10 @@ pub fn setup_triangle(
             depth[0].max(depth[1]).max(depth[2]),
         ],
         depth,
-        inv_w,
+        inv_w: [v0.inv_w, v1.inv_w, v2.inv_w],
         bary_gradient: [
-            [
-                edges[1].a as f32 / area2 as f32,
-                edges[1].b as f32 / area2 as f32,
-            ],
-            [
-                edges[2].a as f32 / area2 as f32,
-                edges[2].b as f32 / area2 as f32,
-            ],
+            [edges[1].a as f32 / area_f, edges[1].b as f32 / area_f],
+            [edges[2].a as f32 / area_f, edges[2].b as f32 / area_f],
         ],
         draw: 0,
         primitive_id: 0,

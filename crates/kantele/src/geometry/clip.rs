@@ -25,7 +25,7 @@
 //! Triangles that need no clipping ([`ClipTest::Accept`]) never come here, so ordinary
 //! geometry is set up from its unmodified vertex positions.
 
-use glam::{DVec4, Vec4};
+use glam::{DVec4, Vec3A, Vec4};
 
 use crate::MAX_VARYINGS;
 
@@ -105,20 +105,24 @@ impl GuardBand {
 /// Classifies a triangle: reject when all three vertices are outside one of the six view-volume
 /// planes, accept when no clipping plane is crossed, clip otherwise.
 pub fn classify(p: [Vec4; 3], guard: &GuardBand) -> ClipTest {
-    let outside = |f: &dyn Fn(Vec4) -> bool| p.iter().all(|&v| f(v));
-    if outside(&|v| v.x > v.w)
-        || outside(&|v| v.x < -v.w)
-        || outside(&|v| v.y > v.w)
-        || outside(&|v| v.y < -v.w)
-        || outside(&|v| v.z > v.w)
-        || outside(&|v| v.z < -v.w)
-    {
+    // One bit per view-volume plane a vertex is strictly outside of (an outcode, from two
+    // lane-wise comparisons): the triangle is rejected when all three share a bit. A NaN
+    // coordinate sets no bit.
+    let outcode = |v: Vec4| {
+        let xyz = Vec3A::new(v.x, v.y, v.z);
+        let w = Vec3A::splat(v.w);
+        xyz.cmpgt(w).bitmask() | xyz.cmplt(-w).bitmask() << 3
+    };
+    if outcode(p[0]) & outcode(p[1]) & outcode(p[2]) != 0 {
         return ClipTest::Reject;
     }
+    // Inside: |x| ≤ k_x·w, |y| ≤ k_y·w, −z ≤ w (z ≥ −w) and W_MIN ≤ w, all four at once.
     let inside = |v: Vec4| {
-        v.z >= -v.w && v.w >= W_MIN && v.x.abs() <= guard.k_x * v.w && v.y.abs() <= guard.k_y * v.w
+        Vec4::new(v.x.abs(), v.y.abs(), -v.z, W_MIN)
+            .cmple(Vec4::new(guard.k_x * v.w, guard.k_y * v.w, v.w, v.w))
+            .all()
     };
-    if p.iter().all(|&v| inside(v)) {
+    if inside(p[0]) && inside(p[1]) && inside(p[2]) {
         ClipTest::Accept
     } else {
         ClipTest::Clip
@@ -263,6 +267,72 @@ mod tests {
             Vec4::new(0.0, 0.5, 0.0, 1.0),
         ];
         assert_eq!(classify(inside, &guard), ClipTest::Accept);
+    }
+
+    /// The rules of [`classify`] written plane by plane.
+    fn classify_by_planes(p: [Vec4; 3], guard: &GuardBand) -> ClipTest {
+        let planes: [fn(Vec4) -> bool; 6] = [
+            |v| v.x > v.w,
+            |v| v.x < -v.w,
+            |v| v.y > v.w,
+            |v| v.y < -v.w,
+            |v| v.z > v.w,
+            |v| v.z < -v.w,
+        ];
+        if planes.iter().any(|out| p.iter().all(|&v| out(v))) {
+            return ClipTest::Reject;
+        }
+        let inside = |v: &Vec4| {
+            v.z >= -v.w
+                && v.w >= W_MIN
+                && v.x.abs() <= guard.k_x * v.w
+                && v.y.abs() <= guard.k_y * v.w
+        };
+        if p.iter().all(inside) {
+            ClipTest::Accept
+        } else {
+            ClipTest::Clip
+        }
+    }
+
+    #[test]
+    fn outcodes_classify_as_the_planes_do() {
+        let guard = GuardBand::new(64, 48);
+        // Coordinates on, inside and outside every plane, the guard band and W_MIN, and NaN.
+        let values = [
+            0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.0,
+            -2.0,
+            600.0,
+            -600.0,
+            1e-6,
+            f32::NAN,
+            f32::INFINITY,
+        ];
+        let ws = [1.0, 2.0, 1e-6, 0.0, -1.0, f32::NAN];
+        let mut state = 0x9e37_79b9u32;
+        let mut pick = |n: usize| {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as usize % n
+        };
+        let mut seen = [0usize; 3];
+        for _ in 0..20_000 {
+            let p: [Vec4; 3] = std::array::from_fn(|_| {
+                let w = ws[pick(ws.len())];
+                let mut c = || values[pick(values.len())] * if pick(2) == 0 { 1.0 } else { w };
+                Vec4::new(c(), c(), c(), w)
+            });
+            let expected = classify_by_planes(p, &guard);
+            assert_eq!(classify(p, &guard), expected, "{p:?}");
+            seen[expected as usize] += 1;
+        }
+        assert!(seen.iter().all(|&n| n > 100), "{seen:?}");
     }
 
     #[test]

@@ -9,7 +9,7 @@ use super::shader::Shader;
 use crate::geometry::clip::{classify, ClipPolygon, ClipTest, ClipVertex};
 use crate::raster::BlockCoverage;
 use crate::rop::{DepthFunc, TileBuffer};
-use crate::setup::{setup_triangle, SetupReject, TriangleSetup, Viewport};
+use crate::setup::{setup_window_triangle, SetupReject, TriangleSetup, Viewport, WindowVertex};
 use crate::simd::Isa;
 use crate::state::RenderState;
 use crate::MAX_VARYINGS;
@@ -99,12 +99,12 @@ impl<S: Shader> DrawCall<'_, S> {
         &self,
         draw: u32,
         primitive_id: u32,
-        pos: [Vec4; 3],
+        window: [WindowVertex; 3],
         varyings: [&[f32]; 3],
         viewport: &Viewport,
         out: &mut PrimitiveBatch,
     ) {
-        match setup_triangle(viewport, pos, self.state.cull, self.state.front_face) {
+        match setup_window_triangle(viewport, window, self.state.cull, self.state.front_face) {
             Ok(mut tri) => {
                 tri.draw = draw;
                 tri.primitive_id = primitive_id;
@@ -191,7 +191,10 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
             let vary = ix.map(|i| &shaded.varyings[i * n..(i + 1) * n]);
             match classify(pos, guard) {
                 ClipTest::Reject => out.counters.rejected += 1,
-                ClipTest::Accept => self.emit(draw, t as u32, pos, vary, viewport, out),
+                ClipTest::Accept => {
+                    let window = ix.map(|i| shaded.window[i]);
+                    self.emit(draw, t as u32, window, vary, viewport, out)
+                }
                 ClipTest::Clip => {
                     out.counters.clipped += 1;
                     let vertex = |k: usize| {
@@ -214,7 +217,7 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
                         self.emit(
                             draw,
                             t as u32,
-                            [a.pos_clip, b.pos_clip, c.pos_clip],
+                            [a.pos_clip, b.pos_clip, c.pos_clip].map(|p| viewport.window_vertex(p)),
                             [&a.varyings[..n], &b.varyings[..n], &c.varyings[..n]],
                             viewport,
                             out,

@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use super::budget::FrameBudget;
 use super::draw::DrawJob;
 use crate::geometry::clip::GuardBand;
-use crate::setup::{TriangleSetup, Viewport};
+use crate::setup::{TriangleSetup, Viewport, WindowVertex};
 use crate::stats::FrameStats;
 
 /// Triangle counters of the primitive stage.
@@ -83,6 +83,10 @@ const VERTEX_CHUNK: usize = 2048;
 #[derive(Default)]
 pub(super) struct ShadedVertices {
     pub(super) pos_clip: Vec<Vec4>,
+    /// Each vertex in window space ([`Viewport::window_vertex`]), computed once per vertex for
+    /// the triangles that need no clipping (meaningless for vertices outside the guard band,
+    /// which such triangles do not have).
+    pub(super) window: Vec<WindowVertex>,
     pub(super) varyings: Vec<f32>,
 }
 
@@ -120,6 +124,10 @@ pub(super) struct GeometryScratch {
     /// Primitive-stage output per chunk (only the first `current_batches` are current).
     pub(super) batches: Vec<PrimitiveBatch>,
     pub(super) current_batches: usize,
+    /// The primitive stage's units of work, `(draw, first triangle, end)`, one per batch.
+    primitive_jobs: Vec<(usize, usize, usize)>,
+    /// Each draw's back-to-front triangle order, where its state asks for one.
+    orders: Vec<Option<Vec<u32>>>,
 }
 
 impl GeometryScratch {
@@ -142,44 +150,56 @@ pub(super) fn run_geometry(
         shaded,
         batches,
         current_batches,
+        primitive_jobs,
+        orders,
     } = scratch;
     // 1. Vertex stage over all draws, in chunks.
     if shaded.len() < draws.len() {
         shaded.resize_with(draws.len(), ShadedVertices::default);
     }
     let shaded = &mut shaded[..draws.len()];
+    // Every element is overwritten below: resizing without clearing keeps last frame's values
+    // in place of a fill with zeros (a frame stopped by its budget draws nothing from them).
     for (d, out) in draws.iter().zip(shaded.iter_mut()) {
-        out.pos_clip.clear();
         out.pos_clip.resize(d.vertex_count(), Vec4::ZERO);
-        out.varyings.clear();
+        out.window.resize(d.vertex_count(), WindowVertex::default());
         out.varyings
             .resize(d.vertex_count() * d.varying_count(), 0.0);
     }
-    let mut vertex_jobs = Vec::new();
-    for (draw, out) in shaded.iter_mut().enumerate() {
-        let n = draws[draw].varying_count();
-        let vary_chunks: Box<dyn Iterator<Item = &mut [f32]>> = if n == 0 {
-            Box::new(std::iter::repeat_with(|| &mut [][..]))
+    // Draws in parallel, and each draw's vertices in chunks (no job list to allocate).
+    shaded.par_iter_mut().enumerate().for_each(|(draw, out)| {
+        let job = &draws[draw];
+        let n = job.varying_count();
+        let run =
+            |chunk: usize, pos: &mut [Vec4], window: &mut [WindowVertex], vary: &mut [f32]| {
+                // Budget: a chunk at a time (robust branch).
+                if budget.exhausted() {
+                    return;
+                }
+                job.shade_vertices(chunk * VERTEX_CHUNK, pos, vary);
+                for (w, p) in window.iter_mut().zip(pos.iter()) {
+                    *w = viewport.window_vertex(*p);
+                }
+            };
+        let ShadedVertices {
+            pos_clip,
+            window,
+            varyings,
+        } = out;
+        let chunks = pos_clip
+            .par_chunks_mut(VERTEX_CHUNK)
+            .zip(window.par_chunks_mut(VERTEX_CHUNK));
+        if n == 0 {
+            chunks
+                .enumerate()
+                .for_each(|(chunk, (pos, window))| run(chunk, pos, window, &mut []));
         } else {
-            Box::new(out.varyings.chunks_mut(VERTEX_CHUNK * n))
-        };
-        for (chunk, (pos, vary)) in out
-            .pos_clip
-            .chunks_mut(VERTEX_CHUNK)
-            .zip(vary_chunks)
-            .enumerate()
-        {
-            vertex_jobs.push((draw, chunk * VERTEX_CHUNK, pos, vary));
+            chunks
+                .zip(varyings.par_chunks_mut(VERTEX_CHUNK * n))
+                .enumerate()
+                .for_each(|(chunk, ((pos, window), vary))| run(chunk, pos, window, vary));
         }
-    }
-    vertex_jobs
-        .into_par_iter()
-        .for_each(|(draw, first, pos, vary)| {
-            // Budget: a chunk at a time (robust branch).
-            if !budget.exhausted() {
-                draws[draw].shade_vertices(first, pos, vary);
-            }
-        });
+    });
     let shaded = &*shaded;
     if budget.exhausted() {
         *current_batches = 0;
@@ -187,12 +207,12 @@ pub(super) fn run_geometry(
     }
 
     // 2. Primitive stage over all draws, in chunks; results concatenated in order.
-    let mut primitive_jobs = Vec::new();
-    let orders: Vec<Option<Vec<u32>>> = draws
+    primitive_jobs.clear();
+    draws
         .par_iter()
         .zip(shaded.par_iter())
         .map(|(d, s)| d.sort_order(s))
-        .collect();
+        .collect_into_vec(orders);
     for (draw, d) in draws.iter().enumerate() {
         let count = d.triangle_count();
         let mut first = 0;
