@@ -105,24 +105,58 @@ impl GuardBand {
 /// Classifies a triangle: reject when all three vertices are outside one of the six view-volume
 /// planes, accept when no clipping plane is crossed, clip otherwise.
 pub fn classify(p: [Vec4; 3], guard: &GuardBand) -> ClipTest {
-    // One bit per view-volume plane a vertex is strictly outside of (an outcode, from two
-    // lane-wise comparisons): the triangle is rejected when all three share a bit. A NaN
-    // coordinate sets no bit.
-    let outcode = |v: Vec4| {
+    classify_codes(p.map(|v| ClipCode::of(v, guard)))
+}
+
+/// What [`classify`] needs to know about one vertex, computed once per vertex and combined per
+/// triangle with [`classify_codes`]: bits 0–5 the view-volume planes the vertex is strictly
+/// outside of (an outcode: x > w, x < −w, y > w, y < −w, z > w, z < −w; a NaN sets none),
+/// [`ClipCode::INSIDE`] when it needs no clipping, [`ClipCode::FINITE`] when every coordinate
+/// is finite.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct ClipCode(pub u8);
+
+impl ClipCode {
+    /// Bits of the six view-volume planes.
+    pub const OUTSIDE: u8 = 0x3f;
+    /// Inside the near plane, `w ≥ W_MIN` and inside the guard band.
+    pub const INSIDE: u8 = 0x40;
+    /// All four coordinates finite.
+    pub const FINITE: u8 = 0x80;
+
+    /// The code of clip-space position `v`.
+    #[inline]
+    pub fn of(v: Vec4, guard: &GuardBand) -> Self {
+        // Two lane-wise comparisons give the outcode.
         let xyz = Vec3A::new(v.x, v.y, v.z);
         let w = Vec3A::splat(v.w);
-        xyz.cmpgt(w).bitmask() | xyz.cmplt(-w).bitmask() << 3
-    };
-    if outcode(p[0]) & outcode(p[1]) & outcode(p[2]) != 0 {
-        return ClipTest::Reject;
-    }
-    // Inside: |x| ≤ k_x·w, |y| ≤ k_y·w, −z ≤ w (z ≥ −w) and W_MIN ≤ w, all four at once.
-    let inside = |v: Vec4| {
-        Vec4::new(v.x.abs(), v.y.abs(), -v.z, W_MIN)
+        let outside = xyz.cmpgt(w).bitmask() | xyz.cmplt(-w).bitmask() << 3;
+        // |x| ≤ k_x·w, |y| ≤ k_y·w, −z ≤ w (z ≥ −w) and W_MIN ≤ w, all four at once.
+        let inside = Vec4::new(v.x.abs(), v.y.abs(), -v.z, W_MIN)
             .cmple(Vec4::new(guard.k_x * v.w, guard.k_y * v.w, v.w, v.w))
-            .all()
-    };
-    if inside(p[0]) && inside(p[1]) && inside(p[2]) {
+            .all();
+        Self(
+            outside as u8
+                | if inside { Self::INSIDE } else { 0 }
+                | if v.is_finite() { Self::FINITE } else { 0 },
+        )
+    }
+
+    /// Whether all of the triangle's coordinates are finite.
+    #[inline]
+    pub fn all_finite(codes: [ClipCode; 3]) -> bool {
+        codes[0].0 & codes[1].0 & codes[2].0 & Self::FINITE != 0
+    }
+}
+
+/// [`classify`] from the vertices' [`ClipCode`]s: rejected when all three are outside one plane,
+/// accepted when all three are inside.
+#[inline]
+pub fn classify_codes(codes: [ClipCode; 3]) -> ClipTest {
+    let all = codes[0].0 & codes[1].0 & codes[2].0;
+    if all & ClipCode::OUTSIDE != 0 {
+        ClipTest::Reject
+    } else if all & ClipCode::INSIDE != 0 {
         ClipTest::Accept
     } else {
         ClipTest::Clip

@@ -6,7 +6,7 @@ use glam::Vec4;
 use super::fragment::{shade_triangle, RasterCounters};
 use super::geometry::{PrimitiveBatch, ShadedVertices, TargetSpace};
 use super::shader::Shader;
-use crate::geometry::clip::{classify, ClipPolygon, ClipTest, ClipVertex};
+use crate::geometry::clip::{classify_codes, ClipCode, ClipPolygon, ClipTest, ClipVertex};
 use crate::raster::BlockCoverage;
 use crate::rop::{DepthFunc, TileBuffer};
 use crate::setup::{setup_window_triangle, SetupReject, TriangleSetup, Viewport, WindowVertex};
@@ -183,13 +183,14 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
             out.counters.triangles_in += 1;
             let t = order.map_or(slot, |o| o[slot] as usize);
             let ix = self.triangle_vertices(t);
-            let pos = ix.map(|i| shaded.pos_clip[i]);
-            if !pos.iter().all(|p| p.is_finite()) {
+            // Per-vertex codes from the vertex stage (`ClipCode::of`), combined.
+            let codes = ix.map(|i| shaded.clip_codes[i]);
+            if !ClipCode::all_finite(codes) {
                 out.counters.invalid += 1;
                 continue;
             }
             let vary = ix.map(|i| &shaded.varyings[i * n..(i + 1) * n]);
-            match classify(pos, guard) {
+            match classify_codes(codes) {
                 ClipTest::Reject => out.counters.rejected += 1,
                 ClipTest::Accept => {
                     let window = ix.map(|i| shaded.window[i]);
@@ -197,6 +198,7 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
                 }
                 ClipTest::Clip => {
                     out.counters.clipped += 1;
+                    let pos = ix.map(|i| shaded.pos_clip[i]);
                     let vertex = |k: usize| {
                         let mut v = ClipVertex {
                             pos_clip: pos[k],

@@ -9,7 +9,7 @@ use rayon::prelude::*;
 
 use super::budget::FrameBudget;
 use super::draw::DrawJob;
-use crate::geometry::clip::GuardBand;
+use crate::geometry::clip::{ClipCode, GuardBand};
 use crate::setup::{TriangleSetup, Viewport, WindowVertex};
 use crate::stats::FrameStats;
 
@@ -79,6 +79,9 @@ const _: () = assert!(
 /// Vertices per unit of parallel work in the vertex stage.
 const VERTEX_CHUNK: usize = 2048;
 
+/// One vertex-stage chunk's outputs besides the varyings: positions, window vertices, clip codes.
+type VertexOutputs<'o> = (&'o mut [Vec4], &'o mut [WindowVertex], &'o mut [ClipCode]);
+
 /// Output of the vertex stage for one draw.
 #[derive(Default)]
 pub(super) struct ShadedVertices {
@@ -87,6 +90,8 @@ pub(super) struct ShadedVertices {
     /// the triangles that need no clipping (meaningless for vertices outside the guard band,
     /// which such triangles do not have).
     pub(super) window: Vec<WindowVertex>,
+    /// Each vertex's [`ClipCode`] (finite, outcode, inside the guard band).
+    pub(super) clip_codes: Vec<ClipCode>,
     pub(super) varyings: Vec<f32>,
 }
 
@@ -163,41 +168,51 @@ pub(super) fn run_geometry(
     for (d, out) in draws.iter().zip(shaded.iter_mut()) {
         out.pos_clip.resize(d.vertex_count(), Vec4::ZERO);
         out.window.resize(d.vertex_count(), WindowVertex::default());
+        out.clip_codes.resize(d.vertex_count(), ClipCode::default());
         out.varyings
             .resize(d.vertex_count() * d.varying_count(), 0.0);
     }
+    let guard = GuardBand::new(viewport.width, viewport.height);
     // Draws in parallel, and each draw's vertices in chunks (no job list to allocate).
     shaded.par_iter_mut().enumerate().for_each(|(draw, out)| {
         let job = &draws[draw];
         let n = job.varying_count();
-        let run =
-            |chunk: usize, pos: &mut [Vec4], window: &mut [WindowVertex], vary: &mut [f32]| {
-                // Budget: a chunk at a time (robust branch).
-                if budget.exhausted() {
-                    return;
-                }
-                job.shade_vertices(chunk * VERTEX_CHUNK, pos, vary);
-                for (w, p) in window.iter_mut().zip(pos.iter()) {
-                    *w = viewport.window_vertex(*p);
-                }
-            };
+        let run = |chunk: usize, (pos, window, codes): VertexOutputs<'_>, vary: &mut [f32]| {
+            // Budget: a chunk at a time (robust branch).
+            if budget.exhausted() {
+                return;
+            }
+            job.shade_vertices(chunk * VERTEX_CHUNK, pos, vary);
+            for ((w, c), p) in window.iter_mut().zip(codes.iter_mut()).zip(pos.iter()) {
+                *w = viewport.window_vertex(*p);
+                *c = ClipCode::of(*p, &guard);
+            }
+        };
         let ShadedVertices {
             pos_clip,
             window,
+            clip_codes,
             varyings,
         } = out;
+        if pos_clip.len() <= VERTEX_CHUNK {
+            // One chunk (a small draw, e.g. one of 2500 cubes): no nested parallel iterator.
+            run(0, (pos_clip, window, clip_codes), varyings);
+            return;
+        }
         let chunks = pos_clip
             .par_chunks_mut(VERTEX_CHUNK)
-            .zip(window.par_chunks_mut(VERTEX_CHUNK));
+            .zip(window.par_chunks_mut(VERTEX_CHUNK))
+            .zip(clip_codes.par_chunks_mut(VERTEX_CHUNK))
+            .map(|((pos, window), codes)| (pos, window, codes));
         if n == 0 {
             chunks
                 .enumerate()
-                .for_each(|(chunk, (pos, window))| run(chunk, pos, window, &mut []));
+                .for_each(|(chunk, outputs)| run(chunk, outputs, &mut []));
         } else {
             chunks
                 .zip(varyings.par_chunks_mut(VERTEX_CHUNK * n))
                 .enumerate()
-                .for_each(|(chunk, ((pos, window), vary))| run(chunk, pos, window, vary));
+                .for_each(|(chunk, (outputs, vary))| run(chunk, outputs, vary));
         }
     });
     let shaded = &*shaded;
