@@ -48,8 +48,8 @@ struct TriangleSetup {
     float bary_gradient[2][2];
     u32 draw;
     u32 primitive_id;
-    unsigned char front_facing;
-    unsigned char swapped;
+    u32 flags;     // KANTELE_TRIANGLE_FRONT_FACING | KANTELE_TRIANGLE_SWAPPED
+    u32 reserved;  // always 0
 };
 
 // `kantele_cuda::records::SamplerCodes`: a texture binding's sampler.
@@ -499,8 +499,9 @@ __device__ int setup_triangle(const FrameUniforms& f, const V4 pos_clip[3], bool
     t.bary_gradient[1][1] = divide(__ll2float_rn(t.edges[2].b), area_f);
     t.draw = 0;
     t.primitive_id = 0;
-    t.front_facing = front_facing ? 1 : 0;
-    t.swapped = swapped ? 1 : 0;
+    t.flags = (front_facing ? KANTELE_TRIANGLE_FRONT_FACING : 0u) |
+              (swapped ? KANTELE_TRIANGLE_SWAPPED : 0u);
+    t.reserved = 0;
     return SETUP_OK;
 }
 
@@ -690,7 +691,7 @@ __device__ __forceinline__ V3 material_normal(const DrawRecord& d, const Fragmen
 __device__ __forceinline__ V4 auxiliary(const FrameUniforms& f, const DrawRecord& d,
                                         const FragmentInput& in, const TriangleSetup& t) {
     if (f.pass == KANTELE_PASS_NORMALS) {
-        V3 n = material_normal(d, in, t.front_facing != 0);
+        V3 n = material_normal(d, in, (t.flags & KANTELE_TRIANGLE_FRONT_FACING) != 0);
         return {n.x, n.y, n.z, 1.0f};
     }
     return {(float)d.node_id, add((float)t.primitive_id, 1.0f), (float)d.draw_id, 1.0f};
@@ -736,7 +737,7 @@ __device__ bool shade_fragment(const FrameUniforms& f, const SceneView& s, const
         out = {base.x, base.y, base.z, alpha};
         return true;
     }
-    V3 n = material_normal(d, in, t.front_facing != 0);
+    V3 n = material_normal(d, in, (t.flags & KANTELE_TRIANGLE_FRONT_FACING) != 0);
     float n_dot_l = rmax(v3_dot(n, {f.to_light[0], f.to_light[1], f.to_light[2]}), 0.0f);
     float k = mul(sub(1.0f, f.ambient), n_dot_l);
     V3 light = {add(f.ambient, mul(k, f.light_color[0])), add(f.ambient, mul(k, f.light_color[1])),

@@ -19,8 +19,8 @@ extern "C" __global__ void kantele_layout_probe(const TriangleSetup* t, const Dr
     out[i++] = OFFSET(t, bary_gradient);
     out[i++] = OFFSET(t, draw);
     out[i++] = OFFSET(t, primitive_id);
-    out[i++] = OFFSET(t, front_facing);
-    out[i++] = OFFSET(t, swapped);
+    out[i++] = OFFSET(t, flags);
+    out[i++] = OFFSET(t, reserved);
     out[i++] = OFFSET(d, normal_matrix);
     out[i++] = OFFSET(d, base_color_factor);
     out[i++] = OFFSET(d, emissive);

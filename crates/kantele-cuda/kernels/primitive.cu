@@ -32,7 +32,8 @@ __device__ __forceinline__ void write_setup(TriangleSetup* setups, float* attrs,
                                             const TriangleSetup& t, const float* va,
                                             const float* vb, const float* vc) {
     setups[index] = t;
-    const float* order[3] = {va, t.swapped ? vc : vb, t.swapped ? vb : vc};
+    const bool swapped = (t.flags & KANTELE_TRIANGLE_SWAPPED) != 0;
+    const float* order[3] = {va, swapped ? vc : vb, swapped ? vb : vc};
     float* out = attrs + (u64)index * 3 * NV;
     for (int v = 0; v < 3; ++v) {
         for (int k = 0; k < NV; ++k) out[v * NV + k] = order[v][k];

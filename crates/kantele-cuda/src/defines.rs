@@ -77,6 +77,8 @@ pub fn defines() -> Vec<(String, String)> {
         ("KANTELE_DRAW_TEXTURED", DRAW_TEXTURED),
         ("KANTELE_DRAW_FRONT_CW", DRAW_FRONT_CW),
         ("KANTELE_DRAW_EMISSIVE_TEXTURED", DRAW_EMISSIVE_TEXTURED),
+        ("KANTELE_TRIANGLE_FRONT_FACING", TriangleSetup::FRONT_FACING),
+        ("KANTELE_TRIANGLE_SWAPPED", TriangleSetup::SWAPPED),
     ] {
         int(name, flag as i64);
     }

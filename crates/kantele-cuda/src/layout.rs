@@ -35,11 +35,8 @@ pub fn fields() -> Vec<(&'static str, u64)> {
             "TriangleSetup.primitive_id",
             offset_of!(T, primitive_id) as u64,
         ),
-        (
-            "TriangleSetup.front_facing",
-            offset_of!(T, front_facing) as u64,
-        ),
-        ("TriangleSetup.swapped", offset_of!(T, swapped) as u64),
+        ("TriangleSetup.flags", offset_of!(T, flags) as u64),
+        ("TriangleSetup.reserved", offset_of!(T, reserved) as u64),
         (
             "DrawRecord.normal_matrix",
             offset_of!(D, normal_matrix) as u64,

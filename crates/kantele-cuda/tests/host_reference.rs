@@ -200,7 +200,13 @@ fn print_setup(out: &mut String, r: Result<TriangleSetup, SetupReject>) {
     };
     out.push_str(&format!(
         "S 0 area {} bbox {} {} {} {} ff {} sw {}",
-        t.area2, t.bbox.x0, t.bbox.y0, t.bbox.x1, t.bbox.y1, t.front_facing as u8, t.swapped as u8
+        t.area2,
+        t.bbox.x0,
+        t.bbox.y0,
+        t.bbox.x1,
+        t.bbox.y1,
+        t.front_facing() as u8,
+        t.swapped() as u8
     ));
     for e in t.edges {
         out.push_str(&format!(" e {} {} {} {}", e.a, e.b, e.c, e.bias));

@@ -41,9 +41,24 @@ pub const SUBPIXEL_LIMIT: i64 = 1 << 24;
 /// and values beyond the guard band are clamped; callers reject those triangles earlier.
 #[inline]
 pub fn snap(window: f32) -> i64 {
-    // `simd::round_ties_even`: `roundss` where the x86-64 baseline would call libm.
-    let scaled = crate::simd::round_ties_even(window * SUBPIXEL_ONE as f32);
+    let scaled = round_ties_even(window * SUBPIXEL_ONE as f32);
     (scaled as i64).clamp(-SUBPIXEL_LIMIT, SUBPIXEL_LIMIT)
+}
+
+/// `x` rounded to the nearest integer, ties to even, as an integral `f32` (the value of
+/// [`f32::round_ties_even`]; the sign of a zero may differ). Plain IEEE arithmetic: below 2^23
+/// in magnitude, adding and subtracting 2^23 (with `x`'s sign) rounds the fraction away in the
+/// default round-to-nearest-even mode; from 2^23 on every `f32` is an integer already. No
+/// library call and no per-call instruction-set check, so it inlines into triangle setup.
+#[inline(always)]
+fn round_ties_even(x: f32) -> f32 {
+    const TWO_POW_23: f32 = 8_388_608.0;
+    if x.abs() < TWO_POW_23 {
+        let shift = TWO_POW_23.copysign(x);
+        (x + shift) - shift
+    } else {
+        x
+    }
 }
 
 /// The sub-pixel coordinate of the centre of pixel `p`.
@@ -65,5 +80,33 @@ mod tests {
         assert_eq!(snap(f32::NAN), 0);
         assert_eq!(snap(1e30), SUBPIXEL_LIMIT);
         assert_eq!(snap(-1e30), -SUBPIXEL_LIMIT);
+    }
+
+    #[test]
+    fn rounding_matches_the_standard_library() {
+        // Ties, near-ties and values around every power of two up to beyond 2^23, both signs.
+        let mut values = vec![0.0f32, -0.0, f32::INFINITY, f32::NEG_INFINITY, f32::MAX];
+        for e in -4..26 {
+            let p = 2f32.powi(e);
+            for x in [p, p + 0.5, p - 0.5, p + 1.5, p * 1.25, p * 1.75] {
+                for v in [x, x.next_up(), x.next_down()] {
+                    values.extend([v, -v]);
+                }
+            }
+        }
+        // A dense sweep of sub-pixel-scaled window coordinates.
+        values.extend((-70_000..70_000).map(|i| i as f32 * 0.37));
+        for x in values {
+            let expected = x.round_ties_even();
+            let got = round_ties_even(x);
+            assert!(got == expected, "{x}: {got} vs {expected}");
+            assert_eq!(snap(x / 256.0), snap_reference(x / 256.0), "{x}");
+        }
+        assert!(round_ties_even(f32::NAN).is_nan());
+    }
+
+    fn snap_reference(window: f32) -> i64 {
+        ((window * SUBPIXEL_ONE as f32).round_ties_even() as i64)
+            .clamp(-SUBPIXEL_LIMIT, SUBPIXEL_LIMIT)
     }
 }

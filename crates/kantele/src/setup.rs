@@ -139,11 +139,35 @@ pub struct TriangleSetup {
     pub draw: u32,
     /// Index of the source triangle within its draw.
     pub primitive_id: u32,
-    /// Whether the triangle is front-facing.
-    pub front_facing: bool,
-    /// Whether vertices 1 and 2 were swapped to make the area positive (varyings follow).
-    pub swapped: bool,
+    /// Bit set of [`TriangleSetup::FRONT_FACING`] and [`TriangleSetup::SWAPPED`] (a `u32`, not
+    /// `bool`s, so a GPU reads the same bytes; other bits are 0).
+    pub flags: u32,
+    /// Always 0: makes the record's end explicit (no compiler padding; the size is a multiple
+    /// of 8 for the `i64` fields).
+    pub reserved: u32,
 }
+
+/// The record's size and field offsets, fixed: the CUDA backend's kernels mirror them
+/// (`kantele-cuda/kernels/common.cuh`, checked again on the device at start-up).
+const _: () = {
+    use std::mem::{offset_of, size_of};
+    type T = TriangleSetup;
+    assert!(size_of::<EdgeFunction>() == 32);
+    assert!(size_of::<PixelRect>() == 16);
+    assert!(offset_of!(T, edges) == 0);
+    assert!(offset_of!(T, area2) == 96);
+    assert!(offset_of!(T, bbox) == 104);
+    assert!(offset_of!(T, pos_subpixel) == 120);
+    assert!(offset_of!(T, depth) == 168);
+    assert!(offset_of!(T, depth_range) == 180);
+    assert!(offset_of!(T, inv_w) == 188);
+    assert!(offset_of!(T, bary_gradient) == 200);
+    assert!(offset_of!(T, draw) == 216);
+    assert!(offset_of!(T, primitive_id) == 220);
+    assert!(offset_of!(T, flags) == 224);
+    assert!(offset_of!(T, reserved) == 228);
+    assert!(size_of::<T>() == 232);
+};
 
 /// Why setup produced no triangle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -205,6 +229,44 @@ impl Viewport {
     }
 }
 
+/// One vertex in window space, as setup reads it: snapped sub-pixel position, window depth and
+/// `1 / w_clip`. Computed once per vertex ([`Viewport::window_vertex`]) and shared by every
+/// triangle that uses the vertex.
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+pub struct WindowVertex {
+    /// Snapped position in sub-pixel units ([`snap`]: within ±`SUBPIXEL_LIMIT`).
+    pub pos: [i32; 2],
+    /// Window depth `(z/w + 1) / 2`.
+    pub depth: f32,
+    /// `1 / w_clip`.
+    pub inv_w: f32,
+}
+
+impl Viewport {
+    /// The window-space vertex of a clip-space position (meaningful for `w > 0` inside the
+    /// guard band; any input gives a defined value).
+    #[inline]
+    pub fn window_vertex(&self, pos_clip: Vec4) -> WindowVertex {
+        let (window, inv_w) = self.to_window(pos_clip);
+        WindowVertex::snapped(window, inv_w)
+    }
+}
+
+impl WindowVertex {
+    /// The vertex at window coordinates `(x, y, depth)` with `1/w = inv_w`, its position snapped
+    /// to the sub-pixel grid (points and lines are expanded into triangles in window space,
+    /// `geometry::wide`).
+    #[inline]
+    pub fn snapped(window: [f32; 3], inv_w: f32) -> Self {
+        // `snap` clamps to ±SUBPIXEL_LIMIT = ±2^24: the value fits an `i32`.
+        WindowVertex {
+            pos: [snap(window[0]) as i32, snap(window[1]) as i32],
+            depth: window[2],
+            inv_w,
+        }
+    }
+}
+
 /// Sets up one triangle from clip-space positions (each with `w > 0`, inside the guard band).
 pub fn setup_triangle(
     viewport: &Viewport,
@@ -212,30 +274,30 @@ pub fn setup_triangle(
     cull: CullMode,
     front_face: FrontFace,
 ) -> Result<TriangleSetup, SetupReject> {
-    let mut window = [[0.0f32; 3]; 3];
-    let mut inv_w = [0.0f32; 3];
-    for i in 0..3 {
-        (window[i], inv_w[i]) = viewport.to_window(pos_clip[i]);
-    }
-    setup_window_triangle(viewport, window, inv_w, cull, front_face)
+    let window = [
+        viewport.window_vertex(pos_clip[0]),
+        viewport.window_vertex(pos_clip[1]),
+        viewport.window_vertex(pos_clip[2]),
+    ];
+    setup_window_triangle(viewport, window, cull, front_face)
 }
 
-/// [`setup_triangle`] from window coordinates `(x, y, depth)` and `1/w` of each vertex (points
-/// and lines are expanded into triangles in window space, `geometry::wide`).
+/// Sets up one triangle from its window-space vertices ([`Viewport::window_vertex`] of positions
+/// with `w > 0` inside the guard band): the same record as [`setup_triangle`].
+#[inline]
 pub fn setup_window_triangle(
     viewport: &Viewport,
-    window: [[f32; 3]; 3],
-    mut inv_w: [f32; 3],
+    window: [WindowVertex; 3],
     cull: CullMode,
     front_face: FrontFace,
 ) -> Result<TriangleSetup, SetupReject> {
-    let mut pos: [[i64; 2]; 3] = [
-        [snap(window[0][0]), snap(window[0][1])],
-        [snap(window[1][0]), snap(window[1][1])],
-        [snap(window[2][0]), snap(window[2][1])],
-    ];
-    let mut area2 = (pos[1][0] - pos[0][0]) * (pos[2][1] - pos[0][1])
-        - (pos[2][0] - pos[0][0]) * (pos[1][1] - pos[0][1]);
+    let [v0, mut v1, mut v2] = window;
+    let area = |v0: &WindowVertex, v1: &WindowVertex, v2: &WindowVertex| {
+        let p0 = [v0.pos[0] as i64, v0.pos[1] as i64];
+        (v1.pos[0] as i64 - p0[0]) * (v2.pos[1] as i64 - p0[1])
+            - (v2.pos[0] as i64 - p0[0]) * (v1.pos[1] as i64 - p0[1])
+    };
+    let mut area2 = area(&v0, &v1, &v2);
     if area2 == 0 {
         return Err(SetupReject::Degenerate);
     }
@@ -249,28 +311,29 @@ pub fn setup_window_triangle(
         (CullMode::Back, false) | (CullMode::Front, true) => return Err(SetupReject::Culled),
         _ => {}
     }
-    let mut depth = [window[0][2], window[1][2], window[2][2]];
     let swapped = area2 < 0;
     if swapped {
-        pos.swap(1, 2);
-        depth.swap(1, 2);
-        inv_w.swap(1, 2);
+        std::mem::swap(&mut v1, &mut v2);
         area2 = -area2;
     }
+    let v = [v0, v1, v2];
+    let pos: [[i64; 2]; 3] = v.map(|v| [v.pos[0] as i64, v.pos[1] as i64]);
     let p = |i: usize| (pos[i][0], pos[i][1]);
     let edges = [
         EdgeFunction::new(p(1), p(2)),
         EdgeFunction::new(p(2), p(0)),
         EdgeFunction::new(p(0), p(1)),
     ];
-    // Pixel x is a candidate when its centre x·256 + 128 lies within [min, max].
-    let min_x = pos.iter().map(|v| v[0]).min().unwrap_or(0);
-    let max_x = pos.iter().map(|v| v[0]).max().unwrap_or(0);
-    let min_y = pos.iter().map(|v| v[1]).min().unwrap_or(0);
-    let max_y = pos.iter().map(|v| v[1]).max().unwrap_or(0);
-    let first =
-        |min: i64| (min - crate::fixed::SUBPIXEL_HALF + SUBPIXEL_ONE - 1).div_euclid(SUBPIXEL_ONE);
-    let last = |max: i64| (max - crate::fixed::SUBPIXEL_HALF).div_euclid(SUBPIXEL_ONE);
+    // Pixel x is a candidate when its centre x·256 + 128 lies within [min, max]; an arithmetic
+    // shift is the floor division by 256.
+    let min_x = pos[0][0].min(pos[1][0]).min(pos[2][0]);
+    let max_x = pos[0][0].max(pos[1][0]).max(pos[2][0]);
+    let min_y = pos[0][1].min(pos[1][1]).min(pos[2][1]);
+    let max_y = pos[0][1].max(pos[1][1]).max(pos[2][1]);
+    let half = crate::fixed::SUBPIXEL_HALF;
+    let bits = crate::fixed::SUBPIXEL_BITS;
+    let first = |min: i64| (min - half + SUBPIXEL_ONE - 1) >> bits;
+    let last = |max: i64| (max - half) >> bits;
     let bbox = PixelRect {
         x0: first(min_x) as i32,
         y0: first(min_y) as i32,
@@ -281,6 +344,8 @@ pub fn setup_window_triangle(
     if bbox.is_empty() {
         return Err(SetupReject::Degenerate);
     }
+    let depth = [v0.depth, v1.depth, v2.depth];
+    let area_f = area2 as f32;
     Ok(TriangleSetup {
         edges,
         area2,
@@ -291,25 +356,38 @@ pub fn setup_window_triangle(
             depth[0].max(depth[1]).max(depth[2]),
         ],
         depth,
-        inv_w,
+        inv_w: [v0.inv_w, v1.inv_w, v2.inv_w],
         bary_gradient: [
-            [
-                edges[1].a as f32 / area2 as f32,
-                edges[1].b as f32 / area2 as f32,
-            ],
-            [
-                edges[2].a as f32 / area2 as f32,
-                edges[2].b as f32 / area2 as f32,
-            ],
+            [edges[1].a as f32 / area_f, edges[1].b as f32 / area_f],
+            [edges[2].a as f32 / area_f, edges[2].b as f32 / area_f],
         ],
         draw: 0,
         primitive_id: 0,
-        front_facing,
-        swapped,
+        flags: (front_facing as u32 * TriangleSetup::FRONT_FACING)
+            | (swapped as u32 * TriangleSetup::SWAPPED),
+        reserved: 0,
     })
 }
 
 impl TriangleSetup {
+    /// [`TriangleSetup::flags`] bit: the triangle is front-facing.
+    pub const FRONT_FACING: u32 = 1;
+    /// [`TriangleSetup::flags`] bit: vertices 1 and 2 were swapped to make the area positive
+    /// (varyings follow).
+    pub const SWAPPED: u32 = 2;
+
+    /// Whether the triangle is front-facing.
+    #[inline]
+    pub fn front_facing(&self) -> bool {
+        self.flags & Self::FRONT_FACING != 0
+    }
+
+    /// Whether vertices 1 and 2 were swapped to make the area positive (varyings follow).
+    #[inline]
+    pub fn swapped(&self) -> bool {
+        self.flags & Self::SWAPPED != 0
+    }
+
     /// Whether the centre of pixel `(x, y)` is covered (top-left rule included).
     #[inline]
     pub fn covers(&self, x: i32, y: i32) -> bool {
@@ -363,7 +441,9 @@ mod tests {
         let vp = Viewport::new(16, 16);
         let ccw = [ndc(-0.5, -0.5), ndc(0.5, -0.5), ndc(0.0, 0.5)];
         let t = setup_triangle(&vp, ccw, CullMode::Back, FrontFace::Ccw).expect("front face");
-        assert!(t.front_facing);
+        assert!(t.front_facing());
+        // Counter-clockwise in NDC is clockwise with window y down: set up swapped.
+        assert!(t.swapped());
         assert!(t.area2 > 0);
         let cw = [ccw[0], ccw[2], ccw[1]];
         assert_eq!(
@@ -371,7 +451,9 @@ mod tests {
             Err(SetupReject::Culled)
         );
         let back = setup_triangle(&vp, cw, CullMode::None, FrontFace::Ccw).expect("not culled");
-        assert!(!back.front_facing);
+        assert!(!back.front_facing());
+        assert!(!back.swapped());
+        assert_eq!(back.flags, 0);
         assert_eq!(
             setup_triangle(&vp, ccw, CullMode::Front, FrontFace::Ccw),
             Err(SetupReject::Culled)

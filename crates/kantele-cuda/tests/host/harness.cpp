@@ -21,7 +21,8 @@ static void print_setup(int code, const TriangleSetup& t) {
         return;
     }
     std::printf("S 0 area %lld bbox %d %d %d %d ff %d sw %d", t.area2, t.bbox.x0, t.bbox.y0, t.bbox.x1,
-                t.bbox.y1, t.front_facing, t.swapped);
+                t.bbox.y1, (t.flags & KANTELE_TRIANGLE_FRONT_FACING) ? 1 : 0,
+                (t.flags & KANTELE_TRIANGLE_SWAPPED) ? 1 : 0);
     for (int e = 0; e < 3; ++e)
         std::printf(" e %lld %lld %lld %lld", t.edges[e].a, t.edges[e].b, t.edges[e].c, t.edges[e].bias);
     for (int i = 0; i < 3; ++i)

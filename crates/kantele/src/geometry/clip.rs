@@ -25,7 +25,7 @@
 //! Triangles that need no clipping ([`ClipTest::Accept`]) never come here, so ordinary
 //! geometry is set up from its unmodified vertex positions.
 
-use glam::{DVec4, Vec4};
+use glam::{DVec4, Vec3A, Vec4};
 
 use crate::MAX_VARYINGS;
 
@@ -105,20 +105,58 @@ impl GuardBand {
 /// Classifies a triangle: reject when all three vertices are outside one of the six view-volume
 /// planes, accept when no clipping plane is crossed, clip otherwise.
 pub fn classify(p: [Vec4; 3], guard: &GuardBand) -> ClipTest {
-    let outside = |f: &dyn Fn(Vec4) -> bool| p.iter().all(|&v| f(v));
-    if outside(&|v| v.x > v.w)
-        || outside(&|v| v.x < -v.w)
-        || outside(&|v| v.y > v.w)
-        || outside(&|v| v.y < -v.w)
-        || outside(&|v| v.z > v.w)
-        || outside(&|v| v.z < -v.w)
-    {
-        return ClipTest::Reject;
+    classify_codes(p.map(|v| ClipCode::of(v, guard)))
+}
+
+/// What [`classify`] needs to know about one vertex, computed once per vertex and combined per
+/// triangle with [`classify_codes`]: bits 0–5 the view-volume planes the vertex is strictly
+/// outside of (an outcode: x > w, x < −w, y > w, y < −w, z > w, z < −w; a NaN sets none),
+/// [`ClipCode::INSIDE`] when it needs no clipping, [`ClipCode::FINITE`] when every coordinate
+/// is finite.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub struct ClipCode(pub u8);
+
+impl ClipCode {
+    /// Bits of the six view-volume planes.
+    pub const OUTSIDE: u8 = 0x3f;
+    /// Inside the near plane, `w ≥ W_MIN` and inside the guard band.
+    pub const INSIDE: u8 = 0x40;
+    /// All four coordinates finite.
+    pub const FINITE: u8 = 0x80;
+
+    /// The code of clip-space position `v`.
+    #[inline]
+    pub fn of(v: Vec4, guard: &GuardBand) -> Self {
+        // Two lane-wise comparisons give the outcode.
+        let xyz = Vec3A::new(v.x, v.y, v.z);
+        let w = Vec3A::splat(v.w);
+        let outside = xyz.cmpgt(w).bitmask() | xyz.cmplt(-w).bitmask() << 3;
+        // |x| ≤ k_x·w, |y| ≤ k_y·w, −z ≤ w (z ≥ −w) and W_MIN ≤ w, all four at once.
+        let inside = Vec4::new(v.x.abs(), v.y.abs(), -v.z, W_MIN)
+            .cmple(Vec4::new(guard.k_x * v.w, guard.k_y * v.w, v.w, v.w))
+            .all();
+        Self(
+            outside as u8
+                | if inside { Self::INSIDE } else { 0 }
+                | if v.is_finite() { Self::FINITE } else { 0 },
+        )
     }
-    let inside = |v: Vec4| {
-        v.z >= -v.w && v.w >= W_MIN && v.x.abs() <= guard.k_x * v.w && v.y.abs() <= guard.k_y * v.w
-    };
-    if p.iter().all(|&v| inside(v)) {
+
+    /// Whether all of the triangle's coordinates are finite.
+    #[inline]
+    pub fn all_finite(codes: [ClipCode; 3]) -> bool {
+        codes[0].0 & codes[1].0 & codes[2].0 & Self::FINITE != 0
+    }
+}
+
+/// [`classify`] from the vertices' [`ClipCode`]s: rejected when all three are outside one plane,
+/// accepted when all three are inside.
+#[inline]
+pub fn classify_codes(codes: [ClipCode; 3]) -> ClipTest {
+    let all = codes[0].0 & codes[1].0 & codes[2].0;
+    if all & ClipCode::OUTSIDE != 0 {
+        ClipTest::Reject
+    } else if all & ClipCode::INSIDE != 0 {
         ClipTest::Accept
     } else {
         ClipTest::Clip
@@ -263,6 +301,72 @@ mod tests {
             Vec4::new(0.0, 0.5, 0.0, 1.0),
         ];
         assert_eq!(classify(inside, &guard), ClipTest::Accept);
+    }
+
+    /// The rules of [`classify`] written plane by plane.
+    fn classify_by_planes(p: [Vec4; 3], guard: &GuardBand) -> ClipTest {
+        let planes: [fn(Vec4) -> bool; 6] = [
+            |v| v.x > v.w,
+            |v| v.x < -v.w,
+            |v| v.y > v.w,
+            |v| v.y < -v.w,
+            |v| v.z > v.w,
+            |v| v.z < -v.w,
+        ];
+        if planes.iter().any(|out| p.iter().all(|&v| out(v))) {
+            return ClipTest::Reject;
+        }
+        let inside = |v: &Vec4| {
+            v.z >= -v.w
+                && v.w >= W_MIN
+                && v.x.abs() <= guard.k_x * v.w
+                && v.y.abs() <= guard.k_y * v.w
+        };
+        if p.iter().all(inside) {
+            ClipTest::Accept
+        } else {
+            ClipTest::Clip
+        }
+    }
+
+    #[test]
+    fn outcodes_classify_as_the_planes_do() {
+        let guard = GuardBand::new(64, 48);
+        // Coordinates on, inside and outside every plane, the guard band and W_MIN, and NaN.
+        let values = [
+            0.0,
+            0.5,
+            -0.5,
+            1.0,
+            -1.0,
+            2.0,
+            -2.0,
+            600.0,
+            -600.0,
+            1e-6,
+            f32::NAN,
+            f32::INFINITY,
+        ];
+        let ws = [1.0, 2.0, 1e-6, 0.0, -1.0, f32::NAN];
+        let mut state = 0x9e37_79b9u32;
+        let mut pick = |n: usize| {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as usize % n
+        };
+        let mut seen = [0usize; 3];
+        for _ in 0..20_000 {
+            let p: [Vec4; 3] = std::array::from_fn(|_| {
+                let w = ws[pick(ws.len())];
+                let mut c = || values[pick(values.len())] * if pick(2) == 0 { 1.0 } else { w };
+                Vec4::new(c(), c(), c(), w)
+            });
+            let expected = classify_by_planes(p, &guard);
+            assert_eq!(classify(p, &guard), expected, "{p:?}");
+            seen[expected as usize] += 1;
+        }
+        assert!(seen.iter().all(|&n| n > 100), "{seen:?}");
     }
 
     #[test]

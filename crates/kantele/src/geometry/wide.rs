@@ -195,7 +195,7 @@ pub fn line_quad(v1: [f32; 2], v2: [f32; 2]) -> Option<WideQuad> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::setup::{setup_window_triangle, CullMode, FrontFace, Viewport};
+    use crate::setup::{setup_window_triangle, CullMode, FrontFace, Viewport, WindowVertex};
     use std::collections::BTreeSet;
 
     /// The pixels a quad covers, through the real triangle setup.
@@ -203,10 +203,9 @@ mod tests {
         let vp = Viewport::new(size, size);
         let mut out = BTreeSet::new();
         for tri in WideQuad::TRIANGLES {
-            let window = tri.map(|i| [quad.corners[i][0], quad.corners[i][1], 0.5]);
-            let Ok(t) =
-                setup_window_triangle(&vp, window, [1.0; 3], CullMode::None, FrontFace::Ccw)
-            else {
+            let window = tri
+                .map(|i| WindowVertex::snapped([quad.corners[i][0], quad.corners[i][1], 0.5], 1.0));
+            let Ok(t) = setup_window_triangle(&vp, window, CullMode::None, FrontFace::Ccw) else {
                 continue;
             };
             for y in t.bbox.y0..t.bbox.y1 {

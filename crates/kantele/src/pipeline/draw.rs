@@ -6,10 +6,10 @@ use glam::Vec4;
 use super::fragment::{shade_triangle, RasterCounters};
 use super::geometry::{PrimitiveBatch, ShadedVertices, TargetSpace};
 use super::shader::Shader;
-use crate::geometry::clip::{classify, ClipPolygon, ClipTest, ClipVertex};
+use crate::geometry::clip::{classify_codes, ClipCode, ClipPolygon, ClipTest, ClipVertex};
 use crate::raster::BlockCoverage;
 use crate::rop::{DepthFunc, TileBuffer};
-use crate::setup::{setup_triangle, SetupReject, TriangleSetup, Viewport};
+use crate::setup::{setup_window_triangle, SetupReject, TriangleSetup, Viewport, WindowVertex};
 use crate::simd::Isa;
 use crate::state::{RenderState, Topology};
 use crate::MAX_VARYINGS;
@@ -101,16 +101,16 @@ impl<S: Shader> DrawCall<'_, S> {
         &self,
         draw: u32,
         primitive_id: u32,
-        pos: [Vec4; 3],
+        window: [WindowVertex; 3],
         varyings: [&[f32]; 3],
         viewport: &Viewport,
         out: &mut PrimitiveBatch,
     ) {
-        match setup_triangle(viewport, pos, self.state.cull, self.state.front_face) {
+        match setup_window_triangle(viewport, window, self.state.cull, self.state.front_face) {
             Ok(mut tri) => {
                 tri.draw = draw;
                 tri.primitive_id = primitive_id;
-                let order = if tri.swapped { [0, 2, 1] } else { [0, 1, 2] };
+                let order = if tri.swapped() { [0, 2, 1] } else { [0, 1, 2] };
                 for v in order {
                     out.attrs.extend_from_slice(varyings[v]);
                 }
@@ -188,17 +188,22 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
             out.counters.triangles_in += 1;
             let t = order.map_or(slot, |o| o[slot] as usize);
             let ix = self.triangle_vertices(t);
-            let pos = ix.map(|i| shaded.pos_clip[i]);
-            if !pos.iter().all(|p| p.is_finite()) {
+            // Per-vertex codes from the vertex stage (`ClipCode::of`), combined.
+            let codes = ix.map(|i| shaded.clip_codes[i]);
+            if !ClipCode::all_finite(codes) {
                 out.counters.invalid += 1;
                 continue;
             }
             let vary = ix.map(|i| &shaded.varyings[i * n..(i + 1) * n]);
-            match classify(pos, guard) {
+            match classify_codes(codes) {
                 ClipTest::Reject => out.counters.rejected += 1,
-                ClipTest::Accept => self.emit(draw, t as u32, pos, vary, viewport, out),
+                ClipTest::Accept => {
+                    let window = ix.map(|i| shaded.window[i]);
+                    self.emit(draw, t as u32, window, vary, viewport, out)
+                }
                 ClipTest::Clip => {
                     out.counters.clipped += 1;
+                    let pos = ix.map(|i| shaded.pos_clip[i]);
                     let vertex = |k: usize| {
                         let mut v = ClipVertex {
                             pos_clip: pos[k],
@@ -219,7 +224,7 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
                         self.emit(
                             draw,
                             t as u32,
-                            [a.pos_clip, b.pos_clip, c.pos_clip],
+                            [a.pos_clip, b.pos_clip, c.pos_clip].map(|p| viewport.window_vertex(p)),
                             [&a.varyings[..n], &b.varyings[..n], &c.varyings[..n]],
                             viewport,
                             out,

@@ -215,7 +215,7 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                     active,
                     depth,
                     primitive_id: tri.primitive_id,
-                    front_facing: tri.front_facing,
+                    front_facing: tri.front_facing(),
                     weights: [q[0] * w, q[1] * w, q[2] * w],
                     w,
                     interpolation: &interpolation,

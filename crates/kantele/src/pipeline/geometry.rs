@@ -9,8 +9,8 @@ use rayon::prelude::*;
 
 use super::budget::FrameBudget;
 use super::draw::DrawJob;
-use crate::geometry::clip::GuardBand;
-use crate::setup::{TriangleSetup, Viewport};
+use crate::geometry::clip::{ClipCode, GuardBand};
+use crate::setup::{TriangleSetup, Viewport, WindowVertex};
 use crate::stats::FrameStats;
 
 /// Triangle counters of the primitive stage.
@@ -79,10 +79,19 @@ const _: () = assert!(
 /// Vertices per unit of parallel work in the vertex stage.
 const VERTEX_CHUNK: usize = 2048;
 
+/// One vertex-stage chunk's outputs besides the varyings: positions, window vertices, clip codes.
+type VertexOutputs<'o> = (&'o mut [Vec4], &'o mut [WindowVertex], &'o mut [ClipCode]);
+
 /// Output of the vertex stage for one draw.
 #[derive(Default)]
 pub(super) struct ShadedVertices {
     pub(super) pos_clip: Vec<Vec4>,
+    /// Each vertex in window space ([`Viewport::window_vertex`]), computed once per vertex for
+    /// the triangles that need no clipping (meaningless for vertices outside the guard band,
+    /// which such triangles do not have).
+    pub(super) window: Vec<WindowVertex>,
+    /// Each vertex's [`ClipCode`] (finite, outcode, inside the guard band).
+    pub(super) clip_codes: Vec<ClipCode>,
     pub(super) varyings: Vec<f32>,
 }
 
@@ -120,6 +129,10 @@ pub(super) struct GeometryScratch {
     /// Primitive-stage output per chunk (only the first `current_batches` are current).
     pub(super) batches: Vec<PrimitiveBatch>,
     pub(super) current_batches: usize,
+    /// The primitive stage's units of work, `(draw, first triangle, end)`, one per batch.
+    primitive_jobs: Vec<(usize, usize, usize)>,
+    /// Each draw's back-to-front triangle order, where its state asks for one.
+    orders: Vec<Option<Vec<u32>>>,
 }
 
 impl GeometryScratch {
@@ -142,44 +155,66 @@ pub(super) fn run_geometry(
         shaded,
         batches,
         current_batches,
+        primitive_jobs,
+        orders,
     } = scratch;
     // 1. Vertex stage over all draws, in chunks.
     if shaded.len() < draws.len() {
         shaded.resize_with(draws.len(), ShadedVertices::default);
     }
     let shaded = &mut shaded[..draws.len()];
+    // Every element is overwritten below: resizing without clearing keeps last frame's values
+    // in place of a fill with zeros (a frame stopped by its budget draws nothing from them).
     for (d, out) in draws.iter().zip(shaded.iter_mut()) {
-        out.pos_clip.clear();
         out.pos_clip.resize(d.vertex_count(), Vec4::ZERO);
-        out.varyings.clear();
+        out.window.resize(d.vertex_count(), WindowVertex::default());
+        out.clip_codes.resize(d.vertex_count(), ClipCode::default());
         out.varyings
             .resize(d.vertex_count() * d.varying_count(), 0.0);
     }
-    let mut vertex_jobs = Vec::new();
-    for (draw, out) in shaded.iter_mut().enumerate() {
-        let n = draws[draw].varying_count();
-        let vary_chunks: Box<dyn Iterator<Item = &mut [f32]>> = if n == 0 {
-            Box::new(std::iter::repeat_with(|| &mut [][..]))
-        } else {
-            Box::new(out.varyings.chunks_mut(VERTEX_CHUNK * n))
-        };
-        for (chunk, (pos, vary)) in out
-            .pos_clip
-            .chunks_mut(VERTEX_CHUNK)
-            .zip(vary_chunks)
-            .enumerate()
-        {
-            vertex_jobs.push((draw, chunk * VERTEX_CHUNK, pos, vary));
-        }
-    }
-    vertex_jobs
-        .into_par_iter()
-        .for_each(|(draw, first, pos, vary)| {
+    let guard = GuardBand::new(viewport.width, viewport.height);
+    // Draws in parallel, and each draw's vertices in chunks (no job list to allocate).
+    shaded.par_iter_mut().enumerate().for_each(|(draw, out)| {
+        let job = &draws[draw];
+        let n = job.varying_count();
+        let run = |chunk: usize, (pos, window, codes): VertexOutputs<'_>, vary: &mut [f32]| {
             // Budget: a chunk at a time (robust branch).
-            if !budget.exhausted() {
-                draws[draw].shade_vertices(first, pos, vary);
+            if budget.exhausted() {
+                return;
             }
-        });
+            job.shade_vertices(chunk * VERTEX_CHUNK, pos, vary);
+            for ((w, c), p) in window.iter_mut().zip(codes.iter_mut()).zip(pos.iter()) {
+                *w = viewport.window_vertex(*p);
+                *c = ClipCode::of(*p, &guard);
+            }
+        };
+        let ShadedVertices {
+            pos_clip,
+            window,
+            clip_codes,
+            varyings,
+        } = out;
+        if pos_clip.len() <= VERTEX_CHUNK {
+            // One chunk (a small draw, e.g. one of 2500 cubes): no nested parallel iterator.
+            run(0, (pos_clip, window, clip_codes), varyings);
+            return;
+        }
+        let chunks = pos_clip
+            .par_chunks_mut(VERTEX_CHUNK)
+            .zip(window.par_chunks_mut(VERTEX_CHUNK))
+            .zip(clip_codes.par_chunks_mut(VERTEX_CHUNK))
+            .map(|((pos, window), codes)| (pos, window, codes));
+        if n == 0 {
+            chunks
+                .enumerate()
+                .for_each(|(chunk, outputs)| run(chunk, outputs, &mut []));
+        } else {
+            chunks
+                .zip(varyings.par_chunks_mut(VERTEX_CHUNK * n))
+                .enumerate()
+                .for_each(|(chunk, (outputs, vary))| run(chunk, outputs, vary));
+        }
+    });
     let shaded = &*shaded;
     if budget.exhausted() {
         *current_batches = 0;
@@ -187,12 +222,12 @@ pub(super) fn run_geometry(
     }
 
     // 2. Primitive stage over all draws, in chunks; results concatenated in order.
-    let mut primitive_jobs = Vec::new();
-    let orders: Vec<Option<Vec<u32>>> = draws
+    primitive_jobs.clear();
+    draws
         .par_iter()
         .zip(shaded.par_iter())
         .map(|(d, s)| d.sort_order(s))
-        .collect();
+        .collect_into_vec(orders);
     for (draw, d) in draws.iter().enumerate() {
         let count = d.primitive_count();
         let mut first = 0;

@@ -10,7 +10,9 @@ use super::shader::Shader;
 use crate::geometry::clip::{ClipVertex, GuardBand};
 use crate::geometry::segment::{clip_segment, point_inside, SegmentClip};
 use crate::geometry::wide::{line_quad, point_quad, WideQuad};
-use crate::setup::{setup_window_triangle, CullMode, FrontFace, SetupReject, Viewport};
+use crate::setup::{
+    setup_window_triangle, CullMode, FrontFace, SetupReject, TriangleSetup, Viewport, WindowVertex,
+};
 use crate::state::Topology;
 use crate::MAX_VARYINGS;
 
@@ -136,18 +138,18 @@ fn emit_quad(
             let c = quad.corners[corners[k]];
             [c[0], c[1], end(k).0]
         };
+        let corner = |k: usize| WindowVertex::snapped(position(k), end(k).1);
         match setup_window_triangle(
             viewport,
-            [position(0), position(1), position(2)],
-            [end(0).1, end(1).1, end(2).1],
+            [corner(0), corner(1), corner(2)],
             CullMode::None,
             FrontFace::Ccw,
         ) {
             Ok(mut tri) => {
                 tri.draw = draw;
                 tri.primitive_id = primitive_id;
-                tri.front_facing = true;
-                let order = if tri.swapped { [0, 2, 1] } else { [0, 1, 2] };
+                tri.flags |= TriangleSetup::FRONT_FACING;
+                let order = if tri.swapped() { [0, 2, 1] } else { [0, 1, 2] };
                 for k in order {
                     out.attrs.extend_from_slice(&end(k).2[..n]);
                 }

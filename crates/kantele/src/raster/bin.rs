@@ -115,6 +115,8 @@ pub struct TileBins {
     chunks: Vec<Vec<Vec<TriangleRef>>>,
     chunk_count: usize,
     tile_count: usize,
+    /// The first batch of each chunk, then the end (kept to avoid an allocation per frame).
+    bounds: Vec<usize>,
 }
 
 /// Fewest triangles per binning chunk: below this, one thread bins them all.
@@ -144,7 +146,8 @@ impl TileBins {
             .clamp(1, wanted)
             .min(batches.len().max(1));
         // Consecutive runs of batches with about `total / chunk_count` triangles each.
-        let mut bounds = Vec::with_capacity(chunk_count + 1);
+        let bounds = &mut self.bounds;
+        bounds.clear();
         bounds.push(0);
         let mut seen = 0;
         for (i, b) in batches.iter().enumerate() {
@@ -161,6 +164,7 @@ impl TileBins {
         }
         self.chunk_count = chunk_count;
         self.tile_count = tile_count;
+        let bounds = &self.bounds;
         self.chunks[..chunk_count]
             .par_iter_mut()
             .enumerate()
