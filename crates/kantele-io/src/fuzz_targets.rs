@@ -7,6 +7,7 @@
 //! the loader's panic net caught), an abort, a scene the loader accepts but the backend refuses,
 //! or a failed render is a defect.
 
+use std::cell::RefCell;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -91,23 +92,35 @@ fn check_and_render(result: Result<LoadedScene, LoadError>) {
         }
     };
     let scene = Arc::new(loaded.scene);
-    let mut cpu = CpuBackend::new(CpuOptions {
-        threads: Some(1),
-        ..CpuOptions::default()
-    })
-    .expect("a CPU backend");
-    cpu.load(scene.clone())
-        .unwrap_or_else(|e| panic!("the loader accepted a scene the backend refuses: {e}"));
-    for pass in [Pass::Color, Pass::Normals, Pass::Ids] {
-        let view = FrameView {
-            pass,
-            ..FrameView::with_camera(&scene, &scene.camera, 32, 32)
-        };
-        cpu.render(&view)
-            .unwrap_or_else(|e| panic!("rendering a loaded scene failed: {e}"));
-        let frame = cpu.read_frame().expect("read the frame back");
-        assert_eq!(frame.color.len(), 32 * 32);
-    }
+    CPU.with(|cell| {
+        let mut slot = cell.borrow_mut();
+        let cpu = slot.get_or_insert_with(|| {
+            CpuBackend::new(CpuOptions {
+                threads: Some(1),
+                ..CpuOptions::default()
+            })
+            .expect("a CPU backend")
+        });
+        cpu.load(scene.clone())
+            .unwrap_or_else(|e| panic!("the loader accepted a scene the backend refuses: {e}"));
+        for pass in [Pass::Color, Pass::Normals, Pass::Ids] {
+            let view = FrameView {
+                pass,
+                ..FrameView::with_camera(&scene, &scene.camera, 32, 32)
+            };
+            cpu.render(&view)
+                .unwrap_or_else(|e| panic!("rendering a loaded scene failed: {e}"));
+            let frame = cpu.read_frame().expect("read the frame back");
+            assert_eq!(frame.color.len(), 32 * 32);
+        }
+    });
+}
+
+thread_local! {
+    /// One CPU backend per thread, reused across inputs: a backend per input would start (and
+    /// leave exiting) a worker thread each time, which is slow and which LeakSanitizer reports
+    /// as a leak of the exiting thread's thread-local destructors.
+    static CPU: RefCell<Option<CpuBackend>> = const { RefCell::new(None) };
 }
 
 /// Whether a panic location lies in Kantele's crates rather than in a dependency.
