@@ -41,6 +41,9 @@ mod accessor;
 mod budget;
 mod builtin;
 mod ear_clip;
+/// Bodies of the fuzz targets in `fuzz/`, callable from stable tests (not a public API).
+#[doc(hidden)]
+pub mod fuzz_targets;
 mod gltf_loader;
 mod gltf_patch;
 pub mod mesh_util;

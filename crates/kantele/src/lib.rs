@@ -112,10 +112,16 @@ pub mod error;
 #[cfg(feature = "fault-injection")]
 pub mod fault;
 pub mod fixed;
+/// Bodies of the fuzz targets in `fuzz/`, callable from stable tests (not a public API).
+#[doc(hidden)]
+pub mod fuzz_targets;
 pub mod geometry;
 pub mod material;
 pub mod pipeline;
 pub mod raster;
+/// The exact coverage reference of the tests and the `raster` fuzz target (not a public API).
+#[doc(hidden)]
+pub mod reference;
 pub mod rop;
 pub mod scene;
 pub mod setup;

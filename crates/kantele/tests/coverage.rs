@@ -4,6 +4,7 @@
 use glam::{Vec2, Vec4};
 use kantele::pipeline::{FnShader, Fragment, Indices, RenderState, Renderer, RendererOptions};
 use kantele::raster::Strategy;
+use kantele::reference::reference_covers;
 use kantele::rop::{BlendMode, DepthFunc};
 use kantele::setup::CullMode;
 use kantele::simd::Isa;
@@ -152,28 +153,6 @@ fn a_fan_covers_its_polygon_exactly_once() {
         }
     }
     assert!(covered > 0);
-}
-
-/// Exact reference coverage: snapped vertices, i128 arithmetic, the top-left rule written as
-/// explicit cases rather than as a bias.
-fn reference_covers(v: [(i64, i64); 3], x: i64, y: i64) -> bool {
-    let (px, py) = (x * 256 + 128, y * 256 + 128);
-    let area = (v[1].0 - v[0].0) as i128 * (v[2].1 - v[0].1) as i128
-        - (v[2].0 - v[0].0) as i128 * (v[1].1 - v[0].1) as i128;
-    if area == 0 {
-        return false;
-    }
-    let v = if area > 0 { v } else { [v[0], v[2], v[1]] };
-    (0..3).all(|i| {
-        let (p, q) = (v[i], v[(i + 1) % 3]);
-        let e = (q.0 - p.0) as i128 * (py - p.1) as i128 - (q.1 - p.1) as i128 * (px - p.0) as i128;
-        if e != 0 {
-            return e > 0;
-        }
-        let is_top = q.1 == p.1 && q.0 > p.0;
-        let is_left = q.1 < p.1;
-        is_top || is_left
-    })
 }
 
 fn snap_ndc(p: Vec2, w: u32, h: u32) -> (i64, i64) {

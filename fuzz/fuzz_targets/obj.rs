@@ -1,0 +1,4 @@
+//! Fuzz target `obj`: see `kantele_io::fuzz_targets::obj`.
+#![no_main]
+
+libfuzzer_sys::fuzz_target!(|data: &[u8]| kantele_io::fuzz_targets::obj(data));
