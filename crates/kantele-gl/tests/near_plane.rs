@@ -15,7 +15,7 @@ use glam::{Mat4, Vec3, Vec4};
 use kantele::backend::{Backend, FrameImage, FrameView};
 use kantele::camera;
 use kantele::cpu::{CpuBackend, CpuOptions};
-use kantele::scene::{Camera, Draw, Light, Material, Mesh, Scene};
+use kantele::scene::{Camera, Draw, Light, Material, Mesh, Scene, Topology};
 
 mod common;
 
@@ -40,6 +40,7 @@ fn ground(extent: f32, eye: Vec3, target: Vec3, znear: f32, zfar: Option<f32>) -
             Vec4::new(1.0, 1.0, 0.2, 1.0),
         ]),
         indices: vec![0, 1, 2, 0, 2, 3],
+        topology: Topology::Triangles,
         material: 0,
     };
     Scene {
@@ -64,6 +65,7 @@ fn ground(extent: f32, eye: Vec3, target: Vec3, znear: f32, zfar: Option<f32>) -
             aspect_ratio: None,
             znear,
             zfar,
+            ymag: None,
         },
         light: Light::Directional {
             to_light: Vec3::Y,
