@@ -113,6 +113,7 @@ pub mod fault;
 pub mod fixed;
 pub mod geometry;
 pub mod material;
+pub mod multisample;
 pub mod pipeline;
 pub mod raster;
 pub mod rop;

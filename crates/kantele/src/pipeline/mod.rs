@@ -17,6 +17,7 @@ mod budget;
 mod draw;
 mod fragment;
 mod geometry;
+mod multisample;
 mod sanitize;
 mod shader;
 
@@ -34,6 +35,7 @@ use self::budget::FrameBudget;
 use self::draw::{DrawCall, DrawJob};
 use self::geometry::{run_geometry, GeometryScratch};
 use crate::error::RenderError;
+use crate::multisample::SampleCount;
 use crate::raster::bin::TileBins;
 use crate::raster::Strategy;
 use crate::rop::Framebuffer;
@@ -56,6 +58,9 @@ pub struct RendererOptions {
     /// out stops between chunks of work, leaves the picture partly drawn and reports
     /// [`FrameStop::TimedOut`] ([`Frame::try_end`]: [`RenderError::TimedOut`]).
     pub timeout: Option<Duration>,
+    /// Samples per pixel of the target (multisample antialiasing; see
+    /// [`crate::multisample`]). The default, 1×, is the single-sample path.
+    pub samples: SampleCount,
 }
 
 /// The CPU renderer: owns the framebuffer and the worker threads.
@@ -83,7 +88,7 @@ impl Renderer {
                 message: format!("cannot start worker threads: {e}"),
             })?;
         Ok(Self {
-            framebuffer: Framebuffer::new(width, height)?,
+            framebuffer: Framebuffer::new(width, height, options.samples)?,
             pool,
             strategy: options.strategy,
             isa: resolve_isa(options.isa),
@@ -98,7 +103,23 @@ impl Renderer {
     pub fn resize(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
         check_target_size(width, height)?;
         if (width, height) != (self.framebuffer.width(), self.framebuffer.height()) {
-            self.framebuffer = Framebuffer::new(width, height)?;
+            self.framebuffer = Framebuffer::new(width, height, self.framebuffer.samples())?;
+        }
+        Ok(())
+    }
+
+    /// Samples per pixel of the target.
+    pub fn samples(&self) -> SampleCount {
+        self.framebuffer.samples()
+    }
+
+    /// Changes the samples per pixel (contents become undefined: clear before drawing); an
+    /// error when the multisampled target would be too large (see
+    /// [`crate::multisample::MAX_MULTISAMPLE_TARGET_BYTES`]).
+    pub fn set_samples(&mut self, samples: SampleCount) -> Result<(), RenderError> {
+        if samples != self.framebuffer.samples() {
+            let (width, height) = (self.framebuffer.width(), self.framebuffer.height());
+            self.framebuffer = Framebuffer::new(width, height, samples)?;
         }
         Ok(())
     }
@@ -271,7 +292,8 @@ impl<'a> Frame<'_, 'a> {
         let budget = FrameBudget::new(start, *timeout, cancel.as_deref());
         pool.install(|| {
             framebuffer.clear(clear_color, clear_depth);
-            let viewport = Viewport::new(framebuffer.width(), framebuffer.height());
+            let viewport = Viewport::new(framebuffer.width(), framebuffer.height())
+                .with_samples(framebuffer.samples());
             let geometry_start = Instant::now();
             run_geometry(&draws, &viewport, &mut stats, scratch, &budget);
             let geometry = scratch.output();
