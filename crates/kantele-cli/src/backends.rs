@@ -6,9 +6,18 @@ use kantele::cpu::{CpuBackend, CpuOptions};
 
 use crate::cli::{BackendKind, CpuArgs};
 
-/// Creates a backend. `fast` asks the GL backend for its RGBA8 target (fair timing) instead of
-/// the float target (pictures). Errors name the backend.
+/// Creates a backend with `--msaa`'s samples per pixel. `fast` asks the GL backend for its
+/// RGBA8 target (fair timing) instead of the float target (pictures). Errors name the backend.
 pub fn make_backend(kind: BackendKind, cpu: &CpuArgs, fast: bool) -> Result<Box<dyn Backend>> {
+    let mut backend = make_plain_backend(kind, cpu, fast)?;
+    backend
+        .set_samples(cpu.msaa)
+        .map_err(|e| anyhow!("--msaa {}: {e}", cpu.msaa))?;
+    Ok(backend)
+}
+
+/// Creates a backend at 1×.
+fn make_plain_backend(kind: BackendKind, cpu: &CpuArgs, fast: bool) -> Result<Box<dyn Backend>> {
     match kind {
         BackendKind::Cpu => {
             let options = CpuOptions {

@@ -56,6 +56,8 @@ struct Row {
     renderer: String,
     threads: usize,
     isa: String,
+    /// Samples per pixel of the colour frames.
+    msaa: usize,
     result: Result<Timing, String>,
     ratio: Option<f64>,
 }
@@ -80,7 +82,7 @@ fn time_frames(
 
 fn print_table(rows: &[Row], ratios: bool) {
     let mut header = format!(
-        "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:<6} {:>10} {:>10} {:>10}",
+        "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:<6} {:>4} {:>10} {:>10} {:>10}",
         "scene",
         "size",
         "triangles",
@@ -89,6 +91,7 @@ fn print_table(rows: &[Row], ratios: bool) {
         "renderer",
         "threads",
         "isa",
+        "msaa",
         "median ms",
         "min ms",
         "max ms"
@@ -100,8 +103,8 @@ fn print_table(rows: &[Row], ratios: bool) {
     for r in rows {
         let size = format!("{}x{}", r.width, r.height);
         let mut line = format!(
-            "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:<6}",
-            r.scene, size, r.triangles, r.draws, r.backend, r.renderer, r.threads, r.isa
+            "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:<6} {:>4}",
+            r.scene, size, r.triangles, r.draws, r.backend, r.renderer, r.threads, r.isa, r.msaa
         );
         match &r.result {
             Ok(t) => {
@@ -129,8 +132,8 @@ fn print_side_by_side(rows: &[Row], backends: &[String]) {
     for name in backends {
         if let Some(r) = rows.iter().find(|r| &r.backend == name && r.result.is_ok()) {
             println!(
-                "{name}: {} ({} threads, isa {})",
-                r.renderer, r.threads, r.isa
+                "{name}: {} ({} threads, isa {}, msaa {})",
+                r.renderer, r.threads, r.isa, r.msaa
             );
         }
     }
@@ -222,6 +225,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let mut reference: Option<f64> = None;
         let mut any_ok = false;
         for (i, (name, backend)) in backends.iter_mut().enumerate() {
+            let msaa = backend.as_ref().map_or(0, |b| b.samples().count());
             let (renderer, threads, isa, result) = match backend {
                 Ok(b) => {
                     let result = b
@@ -257,6 +261,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 renderer,
                 threads,
                 isa,
+                msaa,
                 result,
                 ratio,
             };
@@ -271,7 +276,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                         "scene": row.scene, "source": loaded.info.source,
                         "width": row.width, "height": row.height,
                         "triangles": row.triangles, "draws": row.draws,
-                        "backend": row.backend, "renderer": row.renderer, "threads": row.threads, "isa": row.isa,
+                        "backend": row.backend, "renderer": row.renderer, "threads": row.threads, "isa": row.isa, "msaa": row.msaa,
                         "frames": args.frames, "warmup": args.warmup,
                         "median_ms": median, "min_ms": min, "max_ms": max,
                         "ratio": row.ratio, "available": error.is_none(), "error": error,

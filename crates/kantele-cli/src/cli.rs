@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use clap::{Args, Parser, Subcommand, ValueEnum};
+use kantele::multisample::SampleCount;
 use kantele::raster::Strategy;
 
 /// Kantele: a software rasterizer. Render, inspect, benchmark, compare and view glTF 2.0 / OBJ
@@ -170,6 +171,15 @@ pub struct CpuArgs {
     /// error (a work budget for untrusted scenes).
     #[arg(long, value_name = "SECONDS", value_parser = parse_timeout)]
     pub timeout: Option<std::time::Duration>,
+    /// Multisample antialiasing: samples per pixel, 1, 4 or 8 (colour only: depth, ids and
+    /// normals stay per pixel). Every backend draws it; llvmpipe's OpenGL offers at most 4.
+    #[arg(long, value_name = "N", default_value_t = SampleCount::X1, value_parser = parse_msaa)]
+    pub msaa: SampleCount,
+}
+
+/// Parses `--msaa`: 1, 4 or 8.
+fn parse_msaa(s: &str) -> Result<SampleCount, String> {
+    s.parse()
 }
 
 /// Parses `--timeout`: positive seconds (fractions allowed).

@@ -5,6 +5,7 @@ use std::sync::Arc;
 
 use anyhow::{anyhow, Result};
 use kantele::backend::Pass;
+use kantele::multisample::SampleCount;
 use kantele_io::output::{encode_png_rgba8, write_atomic};
 
 use crate::backends::make_backend;
@@ -49,7 +50,12 @@ pub fn run(args: &ThumbnailArgs) -> Result<()> {
     )?;
     let pose = plan.poses(&loaded, args.size, args.size, &label)?.remove(0);
     let scene = Arc::new(loaded.scene);
-    let mut backend = make_backend(BackendKind::Cpu, &CpuArgs::default(), false)?;
+    // The preset antialiases: 4 samples per pixel.
+    let cpu = CpuArgs {
+        msaa: SampleCount::X4,
+        ..CpuArgs::default()
+    };
+    let mut backend = make_backend(BackendKind::Cpu, &cpu, false)?;
     backend
         .load(scene.clone())
         .map_err(|e| anyhow!("{label}: {e}"))?;

@@ -122,6 +122,7 @@ impl App {
         let mut b = CpuBackend::new(CpuOptions {
             threads: self.args.cpu.threads,
             strategy,
+            samples: self.args.cpu.msaa,
             ..CpuOptions::default()
         })
         .map_err(|e| anyhow!("cpu backend: {e}"))?;

@@ -36,6 +36,14 @@
 //!   application would use); its pictures are quantised and it only renders [`Pass::Color`].
 //! - **Depth.** `GL_DEPTH_COMPONENT32F`, cleared to 1, test `GL_LESS`, default depth range, so
 //!   window depth = `(z/w + 1) / 2`.
+//! - **Multisampling** ([`Backend::set_samples`]): colour frames are drawn into a multisampled
+//!   framebuffer (`glRenderbufferStorageMultisample`, the same colour format and
+//!   `GL_DEPTH_COMPONENT32F`), resolved into the single-sample target with
+//!   `glBlitFramebuffer` (GL averages the samples of a float target in linear space). The
+//!   count is checked against `GL_MAX_SAMPLES` (llvmpipe: 4, so 8× is CPU-only there). The
+//!   depth read back after a multisampled frame is the per-pixel depth of kantele's rule: the
+//!   frame's depth drawn once more at 1× (colour writes off) when it is read back, so it equals
+//!   a 1× render's; the normal and id passes are always drawn at 1×.
 //! - **Textures.** Every level of kantele's mip chain ([`Texture::levels`]) is uploaded as
 //!   its 8-bit texels, `GL_SRGB8_ALPHA8` for sRGB textures and `GL_RGBA8` otherwise, so both
 //!   renderers decode and filter identical texels. Rows go up in memory
@@ -79,6 +87,7 @@ use glam::{Mat3, Mat4, Vec4};
 use glow::HasContext;
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::camera::normal_matrix;
+use kantele::multisample::SampleCount;
 use kantele::scene::{AlphaMode, Scene, Topology};
 use kantele::stats::FrameStats;
 use kantele::RenderError;
@@ -134,6 +143,17 @@ struct Target {
     width: u32,
     height: u32,
     fast: bool,
+    /// The multisampled framebuffer colour frames are drawn into before they are resolved
+    /// into `framebuffer` (`None` at 1×).
+    multisample: Option<MultisampleTarget>,
+}
+
+/// A multisampled framebuffer of the target's size and formats.
+struct MultisampleTarget {
+    framebuffer: glow::Framebuffer,
+    color: glow::Renderbuffer,
+    depth: glow::Renderbuffer,
+    samples: SampleCount,
 }
 
 /// The OpenGL backend: a headless EGL context, the scene's meshes and textures in GL objects, and
@@ -151,6 +171,13 @@ pub struct GlBackend {
     fast_target: bool,
     /// Pass of the last frame rendered into `target` (`None`: nothing rendered yet).
     last_pass: Option<Pass>,
+    /// Samples per pixel of colour frames.
+    samples: SampleCount,
+    /// `GL_MAX_SAMPLES` of the driver.
+    max_samples: i32,
+    /// The view of the last frame when it was multisampled: its per-pixel depth is drawn at
+    /// read-back.
+    multisampled_view: Option<FrameView>,
     renderer: String,
     version: String,
     egl: EglContext,
@@ -197,6 +224,8 @@ impl GlBackend {
         let program = unsafe { build_program(&gl) }.map_err(backend_error)?;
         // SAFETY: `gl` is current; `program` is ours and linked.
         let uniforms = unsafe { uniforms(&gl, program) };
+        // SAFETY: `gl` is current on this thread.
+        let max_samples = unsafe { gl.get_parameter_i32(glow::MAX_SAMPLES) };
         let backend = Self {
             gl,
             program,
@@ -206,6 +235,9 @@ impl GlBackend {
             target: None,
             fast_target: false,
             last_pass: None,
+            samples: SampleCount::X1,
+            max_samples,
+            multisampled_view: None,
             renderer,
             version,
             egl,
@@ -226,6 +258,11 @@ impl GlBackend {
     /// Whether the 8-bit colour target is selected (see [`GlBackend::set_fast_target`]).
     pub fn fast_target(&self) -> bool {
         self.fast_target
+    }
+
+    /// `GL_MAX_SAMPLES`: the most samples per pixel the driver offers (llvmpipe: 4).
+    pub fn max_samples(&self) -> u32 {
+        self.max_samples.max(1) as u32
     }
 
     /// The `GL_RENDERER` string, e.g. `llvmpipe (LLVM 15.0.6, 256 bits)`.
@@ -272,10 +309,24 @@ impl GlBackend {
         }
     }
 
-    /// Creates (or re-creates) the framebuffer for the view's size and the selected format.
-    fn ensure_target(&mut self, width: u32, height: u32) -> Result<(), RenderError> {
+    /// Creates (or re-creates) the framebuffer for the view's size, the selected format and
+    /// `samples` per pixel.
+    fn ensure_target(
+        &mut self,
+        width: u32,
+        height: u32,
+        samples: SampleCount,
+    ) -> Result<(), RenderError> {
         if let Some(t) = &self.target {
-            if t.width == width && t.height == height && t.fast == self.fast_target {
+            let target_samples = t
+                .multisample
+                .as_ref()
+                .map_or(SampleCount::X1, |m| m.samples);
+            if t.width == width
+                && t.height == height
+                && t.fast == self.fast_target
+                && target_samples == samples
+            {
                 return Ok(());
             }
         }
@@ -327,13 +378,14 @@ impl GlBackend {
             );
             gl.bind_renderbuffer(glow::RENDERBUFFER, None);
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
-            let target = Target {
+            let mut target = Target {
                 framebuffer,
                 color,
                 depth,
                 width,
                 height,
                 fast,
+                multisample: None,
             };
             if status != glow::FRAMEBUFFER_COMPLETE {
                 self.target = Some(target);
@@ -341,6 +393,55 @@ impl GlBackend {
                 return Err(backend_error(format!(
                     "framebuffer {width}x{height} incomplete (status 0x{status:04X})"
                 )));
+            }
+            if samples.is_multisampled() {
+                let ms = MultisampleTarget {
+                    framebuffer: gl.create_framebuffer().map_err(backend_error)?,
+                    color: gl.create_renderbuffer().map_err(backend_error)?,
+                    depth: gl.create_renderbuffer().map_err(backend_error)?,
+                    samples,
+                };
+                let n = samples.count() as i32;
+                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(ms.framebuffer));
+                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(ms.color));
+                gl.renderbuffer_storage_multisample(
+                    glow::RENDERBUFFER,
+                    n,
+                    color_format,
+                    width as i32,
+                    height as i32,
+                );
+                gl.framebuffer_renderbuffer(
+                    glow::FRAMEBUFFER,
+                    glow::COLOR_ATTACHMENT0,
+                    glow::RENDERBUFFER,
+                    Some(ms.color),
+                );
+                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(ms.depth));
+                gl.renderbuffer_storage_multisample(
+                    glow::RENDERBUFFER,
+                    n,
+                    glow::DEPTH_COMPONENT32F,
+                    width as i32,
+                    height as i32,
+                );
+                gl.framebuffer_renderbuffer(
+                    glow::FRAMEBUFFER,
+                    glow::DEPTH_ATTACHMENT,
+                    glow::RENDERBUFFER,
+                    Some(ms.depth),
+                );
+                gl.bind_renderbuffer(glow::RENDERBUFFER, None);
+                let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+                target.multisample = Some(ms);
+                if status != glow::FRAMEBUFFER_COMPLETE {
+                    self.target = Some(target);
+                    self.delete_target();
+                    return Err(unsupported(format!(
+                        "{samples}x multisampled framebuffer {width}x{height} incomplete \
+                         (status 0x{status:04X})"
+                    )));
+                }
             }
             target
         };
@@ -357,16 +458,59 @@ impl GlBackend {
                 self.gl.delete_framebuffer(t.framebuffer);
                 self.gl.delete_renderbuffer(t.color);
                 self.gl.delete_renderbuffer(t.depth);
+                if let Some(ms) = t.multisample {
+                    self.gl.delete_framebuffer(ms.framebuffer);
+                    self.gl.delete_renderbuffer(ms.color);
+                    self.gl.delete_renderbuffer(ms.depth);
+                }
             }
         }
         self.last_pass = None;
+        self.multisampled_view = None;
     }
 
-    /// Clear + every draw + glFinish, with the context current and the target bound.
+    /// Resolves the multisampled colour into the single-sample target (`glBlitFramebuffer`).
+    fn resolve(&self) -> Result<(), RenderError> {
+        let target = self.target.as_ref().expect("target was created");
+        let Some(ms) = &target.multisample else {
+            return Ok(());
+        };
+        let (w, h) = (target.width as i32, target.height as i32);
+        // SAFETY: `gl` is current on this thread; both framebuffers are ours, complete and of
+        // the same size and colour format.
+        unsafe {
+            let gl = &self.gl;
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(ms.framebuffer));
+            gl.read_buffer(glow::COLOR_ATTACHMENT0);
+            gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(target.framebuffer));
+            gl.draw_buffers(&[glow::COLOR_ATTACHMENT0]);
+            gl.blit_framebuffer(
+                0,
+                0,
+                w,
+                h,
+                0,
+                0,
+                w,
+                h,
+                glow::COLOR_BUFFER_BIT,
+                glow::NEAREST,
+            );
+            gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+            gl.finish();
+        }
+        self.check("resolving the multisampled frame")
+    }
+
+    /// Clear + every draw + glFinish into `framebuffer` (the target's or its multisampled
+    /// one), with the context current. `depth_only` clears and draws depth alone (colour
+    /// writes off): the per-pixel depth of a multisampled frame.
     fn draw_frame(
         &self,
         scene: &Scene,
         view: &FrameView,
+        framebuffer: glow::Framebuffer,
+        depth_only: bool,
         stats: &mut FrameStats,
     ) -> Result<(), RenderError> {
         let gl = &self.gl;
@@ -390,16 +534,21 @@ impl GlBackend {
         // checked by `Scene::validate` in `load`, and index buffers only hold in-range indices.
         unsafe {
             let target = self.target.as_ref().expect("target was created");
-            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(target.framebuffer));
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
             gl.draw_buffers(&[glow::COLOR_ATTACHMENT0]);
             gl.viewport(0, 0, target.width as i32, target.height as i32);
             gl.disable(glow::SCISSOR_TEST);
             gl.disable(glow::BLEND);
-            gl.color_mask(true, true, true, true);
+            gl.enable(glow::MULTISAMPLE);
+            gl.color_mask(!depth_only, !depth_only, !depth_only, !depth_only);
             gl.depth_mask(true);
             gl.clear_color(clear.x, clear.y, clear.z, clear.w);
             gl.clear_depth_f64(1.0);
-            gl.clear(glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT);
+            gl.clear(if depth_only {
+                glow::DEPTH_BUFFER_BIT
+            } else {
+                glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT
+            });
 
             gl.enable(glow::DEPTH_TEST);
             gl.depth_func(glow::LESS);
@@ -523,6 +672,7 @@ impl GlBackend {
             }
             gl.bind_vertex_array(None);
             gl.depth_mask(true);
+            gl.color_mask(true, true, true, true);
             gl.finish();
         }
         self.check("rendering the frame")
@@ -581,15 +731,49 @@ impl Backend for GlBackend {
                 view.pass
             )));
         }
+        // Ids and normals are never averaged: those passes are drawn at 1×.
+        let samples = match view.pass {
+            Pass::Color => self.samples,
+            Pass::Normals | Pass::Ids => SampleCount::X1,
+        };
         self.make_current()?;
-        self.ensure_target(width, height)?;
+        self.ensure_target(width, height, samples)?;
         self.last_pass = None;
+        self.multisampled_view = None;
         let mut stats = FrameStats::default();
         let start = Instant::now();
-        self.draw_frame(&scene, view, &mut stats)?;
+        let target = self.target.as_ref().expect("target was created");
+        let framebuffer = target
+            .multisample
+            .as_ref()
+            .map_or(target.framebuffer, |ms| ms.framebuffer);
+        self.draw_frame(&scene, view, framebuffer, false, &mut stats)?;
+        self.resolve()?;
         stats.total_time = start.elapsed();
         self.last_pass = Some(view.pass);
+        if samples.is_multisampled() {
+            self.multisampled_view = Some(*view);
+        }
         Ok(stats)
+    }
+
+    /// Sets the samples per pixel of colour frames; an error when the driver offers fewer
+    /// (`GL_MAX_SAMPLES`; llvmpipe offers 4).
+    fn set_samples(&mut self, samples: SampleCount) -> Result<(), RenderError> {
+        if samples.count() as i64 > self.max_samples.max(1) as i64 {
+            return Err(unsupported(format!(
+                "{samples}x multisampling: the driver ({}) offers at most {} samples per pixel \
+                 (GL_MAX_SAMPLES)",
+                self.renderer,
+                self.max_samples.max(1)
+            )));
+        }
+        self.samples = samples;
+        Ok(())
+    }
+
+    fn samples(&self) -> SampleCount {
+        self.samples
     }
 
     fn read_frame(&mut self) -> Result<FrameImage, RenderError> {
@@ -601,8 +785,18 @@ impl Backend for GlBackend {
                 ))
             }
         };
-        self.make_current()?;
         let (width, height) = (target.width, target.height);
+        self.make_current()?;
+        // A multisampled frame's per-pixel depth: its depth drawn again at 1×.
+        if let Some(view) = self.multisampled_view.take() {
+            let scene = self
+                .scene
+                .clone()
+                .ok_or_else(|| backend_error("read_frame called before load"))?;
+            let framebuffer = self.target.as_ref().expect("checked above").framebuffer;
+            self.draw_frame(&scene, &view, framebuffer, true, &mut FrameStats::default())?;
+        }
+        let target = self.target.as_ref().expect("checked above");
         let pixels = width as usize * height as usize;
         let mut color = vec![0u8; pixels * 16];
         let mut depth = vec![0u8; pixels * 4];

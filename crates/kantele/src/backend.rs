@@ -11,6 +11,7 @@ use std::sync::Arc;
 use glam::{Mat4, Vec3};
 
 use crate::error::RenderError;
+use crate::multisample::SampleCount;
 use crate::scene::Scene;
 use crate::stats::FrameStats;
 
@@ -151,4 +152,22 @@ pub trait Backend {
     fn render(&mut self, view: &FrameView) -> Result<FrameStats, RenderError>;
     /// Reads back the last frame.
     fn read_frame(&mut self) -> Result<FrameImage, RenderError>;
+    /// Sets the samples per pixel of later [`Pass::Color`] frames (multisample antialiasing,
+    /// see [`crate::multisample`]); the normal and id passes are always rendered at 1×, and
+    /// the depth read back is the per-pixel (pixel-centre) depth. A backend without
+    /// multisampling (or without this count) returns [`RenderError::Unsupported`] and keeps
+    /// its previous count.
+    fn set_samples(&mut self, samples: SampleCount) -> Result<(), RenderError> {
+        if samples.is_multisampled() {
+            return Err(RenderError::Unsupported {
+                backend: self.name().to_string(),
+                message: format!("{samples}x multisampling is not implemented"),
+            });
+        }
+        Ok(())
+    }
+    /// Samples per pixel of [`Pass::Color`] frames.
+    fn samples(&self) -> SampleCount {
+        SampleCount::X1
+    }
 }

@@ -117,6 +117,7 @@ pub mod fixed;
 pub mod fuzz_targets;
 pub mod geometry;
 pub mod material;
+pub mod multisample;
 pub mod pipeline;
 pub mod raster;
 /// The exact coverage reference of the tests and the `raster` fuzz target (not a public API).

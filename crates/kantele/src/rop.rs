@@ -11,6 +11,7 @@ pub use crate::state::{BlendMode, DepthFunc};
 
 use crate::error::RenderError;
 use crate::fixed::{BLOCK_LOG2, TILE_LOG2, TILE_PIXELS, TILE_SIZE};
+use crate::multisample::{SampleCount, MAX_MULTISAMPLE_TARGET_BYTES};
 
 /// 8 × 8 blocks in a tile (64).
 const BLOCKS_PER_TILE: usize = ((TILE_SIZE >> BLOCK_LOG2) * (TILE_SIZE >> BLOCK_LOG2)) as usize;
@@ -20,12 +21,19 @@ use crate::setup::PixelRect;
 /// One tile's colour and depth, `TILE_SIZE × TILE_SIZE`, row-major within the tile. Colour is
 /// stored as four planes (red, green, blue, alpha; structure of arrays) so that eight adjacent
 /// pixels of a row are one lane load per channel.
+///
+/// A multisampled tile (N samples) holds N planes per channel (channel `c`, sample `s` at plane
+/// `c·N + s`) and N + 1 depth planes: plane 0 is the depth at the pixel centre (the per-pixel
+/// depth read back, see [`crate::multisample`]), plane `1 + s` that of sample `s`. At 1× the
+/// single colour plane per channel and depth plane 0 are the only ones, as before.
 #[derive(Clone, Debug)]
 pub struct TileBuffer {
-    /// Linear colour planes: red at `0..TILE_PIXELS`, then green, blue and alpha.
+    /// Linear colour planes: red at `0..TILE_PIXELS·N`, then green, blue and alpha.
     color: Vec<f32>,
-    /// Window depth.
+    /// Window depth planes: the pixel centre's, then each sample's (multisampled only).
     depth: Vec<f32>,
+    /// Samples per pixel (1, 4 or 8).
+    samples: usize,
     /// An upper bound of every value in `depth` (kept by every depth write).
     depth_bound: f32,
     /// Whether `depth_bound` is the exact maximum (false after writes until recomputed).
@@ -44,10 +52,12 @@ const DEPTH_BOUND_SLACK: f32 = 1e-6;
 const DEPTH_BOUND_REFRESH_AREA: i32 = 1024;
 
 impl TileBuffer {
-    fn new() -> Result<Self, RenderError> {
+    fn new(samples: SampleCount) -> Result<Self, RenderError> {
+        let n = samples.count();
         Ok(Self {
-            color: filled_vec(4 * TILE_PIXELS, 0.0)?,
-            depth: filled_vec(TILE_PIXELS, 1.0)?,
+            color: filled_vec(4 * n * TILE_PIXELS, 0.0)?,
+            depth: filled_vec(depth_planes(samples) * TILE_PIXELS, 1.0)?,
+            samples: n,
             depth_bound: 1.0,
             depth_bound_exact: true,
             block_depth_max: [1.0; BLOCKS_PER_TILE],
@@ -67,18 +77,77 @@ impl TileBuffer {
         &mut self.depth[index..]
     }
 
-    /// The four colour planes from tile index `index` on.
+    /// Samples per pixel of this tile.
+    #[inline(always)]
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+
+    /// Depths of sample `sample` from tile index `index` on (multisampled tiles only).
+    #[inline(always)]
+    pub fn sample_depth_row(&self, sample: usize, index: usize) -> &[f32] {
+        debug_assert!(self.samples > 1 && sample < self.samples);
+        &self.depth[(1 + sample) * TILE_PIXELS + index..]
+    }
+
+    /// Mutable depths of sample `sample` from tile index `index` on (multisampled tiles only).
+    #[inline(always)]
+    pub fn sample_depth_row_mut(&mut self, sample: usize, index: usize) -> &mut [f32] {
+        debug_assert!(self.samples > 1 && sample < self.samples);
+        &mut self.depth[(1 + sample) * TILE_PIXELS + index..]
+    }
+
+    /// Depths of depth plane `plane` (0: pixel centres, `1 + s`: sample `s`) from tile index
+    /// `index` on.
+    #[inline(always)]
+    pub fn depth_plane_row(&self, plane: usize, index: usize) -> &[f32] {
+        &self.depth[plane * TILE_PIXELS + index..]
+    }
+
+    /// Number of depth planes (1 at 1×, samples + 1 when multisampled).
+    #[inline(always)]
+    pub fn depth_plane_count(&self) -> usize {
+        self.depth.len() / TILE_PIXELS
+    }
+
+    /// The four colour planes of sample `sample` from tile index `index` on.
+    #[inline(always)]
+    pub fn sample_color_row(&self, sample: usize, index: usize) -> [&[f32]; 4] {
+        let plane = self.samples * TILE_PIXELS;
+        let at = sample * TILE_PIXELS + index;
+        [
+            &self.color[at..],
+            &self.color[plane + at..],
+            &self.color[2 * plane + at..],
+            &self.color[3 * plane + at..],
+        ]
+    }
+
+    /// The four colour planes of sample `sample` from tile index `index` on, mutable.
+    #[inline(always)]
+    pub fn sample_color_row_mut(&mut self, sample: usize, index: usize) -> [&mut [f32]; 4] {
+        let plane = self.samples * TILE_PIXELS;
+        let at = sample * TILE_PIXELS + index;
+        let (r, rest) = self.color.split_at_mut(plane);
+        let (g, rest) = rest.split_at_mut(plane);
+        let (b, a) = rest.split_at_mut(plane);
+        [&mut r[at..], &mut g[at..], &mut b[at..], &mut a[at..]]
+    }
+
+    /// The four colour planes from tile index `index` on (single-sample tiles).
     #[inline(always)]
     pub fn color_row(&self, index: usize) -> [&[f32]; 4] {
+        debug_assert_eq!(self.samples, 1);
         let (r, rest) = self.color.split_at(TILE_PIXELS);
         let (g, rest) = rest.split_at(TILE_PIXELS);
         let (b, a) = rest.split_at(TILE_PIXELS);
         [&r[index..], &g[index..], &b[index..], &a[index..]]
     }
 
-    /// The four colour planes from tile index `index` on, mutable.
+    /// The four colour planes from tile index `index` on, mutable (single-sample tiles).
     #[inline(always)]
     pub fn color_row_mut(&mut self, index: usize) -> [&mut [f32]; 4] {
+        debug_assert_eq!(self.samples, 1);
         let (r, rest) = self.color.split_at_mut(TILE_PIXELS);
         let (g, rest) = rest.split_at_mut(TILE_PIXELS);
         let (b, a) = rest.split_at_mut(TILE_PIXELS);
@@ -90,9 +159,20 @@ impl TileBuffer {
         ]
     }
 
-    /// The colour of the pixel at tile index `index`.
+    /// The colour of the pixel at tile index `index`; on a multisampled tile the resolved
+    /// colour: the mean of its samples in linear space (summed in sample order).
     #[inline]
     pub fn color_at(&self, index: usize) -> Vec4 {
+        if self.samples > 1 {
+            let plane = self.samples * TILE_PIXELS;
+            let mut sum = [0.0f32; 4];
+            for (c, total) in sum.iter_mut().enumerate() {
+                for s in 0..self.samples {
+                    *total += self.color[c * plane + s * TILE_PIXELS + index];
+                }
+            }
+            return Vec4::from_array(sum) / self.samples as f32;
+        }
         Vec4::new(
             self.color[index],
             self.color[TILE_PIXELS + index],
@@ -140,8 +220,9 @@ impl TileBuffer {
     /// Fills colour and/or depth.
     fn fill(&mut self, color: Option<Vec4>, depth: Option<f32>) {
         if let Some(c) = color {
-            for (plane, value) in self.color.chunks_exact_mut(TILE_PIXELS).zip(c.to_array()) {
-                plane.fill(value);
+            let plane = self.samples * TILE_PIXELS;
+            for (planes, value) in self.color.chunks_exact_mut(plane).zip(c.to_array()) {
+                planes.fill(value);
             }
         }
         if let Some(d) = depth {
@@ -167,15 +248,18 @@ impl TileBuffer {
         if self.depth_bound_exact || area < DEPTH_BOUND_REFRESH_AREA.min(tile_area / 4) {
             return false;
         }
-        // Only pixels on the target: those past its edge keep the clear value forever.
+        // Only pixels on the target: those past its edge keep the clear value forever. Every
+        // depth plane (the pixel centres' and, when multisampled, each sample's).
         let mut bound = f32::NEG_INFINITY;
-        for y in tile.y0..tile.y1 {
-            let row = Self::index(tile.x0, y);
-            let width = tile.width() as usize;
-            bound = self.depth[row..row + width]
-                .iter()
-                .copied()
-                .fold(bound, f32::max);
+        for plane in self.depth.chunks_exact(TILE_PIXELS) {
+            for y in tile.y0..tile.y1 {
+                let row = Self::index(tile.x0, y);
+                let width = tile.width() as usize;
+                bound = plane[row..row + width]
+                    .iter()
+                    .copied()
+                    .fold(bound, f32::max);
+            }
         }
         self.depth_bound = bound;
         self.depth_bound_exact = true;
@@ -206,10 +290,27 @@ fn filled_vec<T: Clone>(n: usize, value: T) -> Result<Vec<T>, RenderError> {
 /// Bytes the tiles of a `width × height` target take: 16 bytes of linear RGBA and 4 of depth
 /// per pixel, for every pixel of the whole 64 × 64 tiles covering it (saturating).
 pub fn framebuffer_bytes(width: u32, height: u32) -> usize {
+    multisample_framebuffer_bytes(width, height, SampleCount::X1)
+}
+
+/// Depth planes of a tile with `samples` samples per pixel.
+fn depth_planes(samples: SampleCount) -> usize {
+    if samples.is_multisampled() {
+        samples.count() + 1
+    } else {
+        1
+    }
+}
+
+/// Bytes the tiles of a `width × height` target with `samples` samples per pixel take: 16
+/// bytes of linear RGBA and 4 of depth per sample, plus 4 of centre depth per pixel when
+/// multisampled, for every pixel of the whole tiles covering it (saturating).
+pub fn multisample_framebuffer_bytes(width: u32, height: u32, samples: SampleCount) -> usize {
     let grid = TileGrid::new(width, height);
+    let floats = 4 * samples.count() + depth_planes(samples);
     grid.tile_count()
         .saturating_mul(TILE_PIXELS)
-        .saturating_mul(5 * std::mem::size_of::<f32>())
+        .saturating_mul(floats * std::mem::size_of::<f32>())
 }
 
 /// Bytes a whole-frame readback of a `width × height` target takes at `bytes_per_pixel`
@@ -228,22 +329,39 @@ pub struct Framebuffer {
     tiles: Vec<TileBuffer>,
     /// The pixel rows held and read back (`0..height` for a whole target).
     rows: std::ops::Range<u32>,
+    samples: SampleCount,
 }
 
 impl Framebuffer {
-    /// A target of `width × height` (sizes checked by the caller), cleared to transparent black
-    /// and depth 1.
-    pub(crate) fn new(width: u32, height: u32) -> Result<Self, RenderError> {
-        Self::band(width, height, 0..height)
+    /// A target of `width × height` with `samples` samples per pixel (sides checked by the
+    /// caller), cleared to transparent black and depth 1.
+    pub(crate) fn new(width: u32, height: u32, samples: SampleCount) -> Result<Self, RenderError> {
+        Self::band(width, height, 0..height, samples)
     }
 
     /// Rows `rows` (non-empty, within `0..height`, checked by the caller) of a `width × height`
-    /// target: only the tiles holding them are allocated.
+    /// target with `samples` samples per pixel: only the tiles holding them are allocated. A
+    /// multisampled band larger than [`MAX_MULTISAMPLE_TARGET_BYTES`] is refused before anything
+    /// is allocated.
     pub(crate) fn band(
         width: u32,
         height: u32,
         rows: std::ops::Range<u32>,
+        samples: SampleCount,
     ) -> Result<Self, RenderError> {
+        let bytes = multisample_framebuffer_bytes(width, rows.end - rows.start, samples);
+        if samples.is_multisampled() && bytes > MAX_MULTISAMPLE_TARGET_BYTES {
+            return Err(RenderError::Unsupported {
+                backend: "cpu".into(),
+                message: format!(
+                    "a {width}x{height} target at {samples} samples per pixel needs {} MiB of \
+                     tile storage, more than the {} MiB limit of multisampled targets (use \
+                     fewer samples or a smaller picture)",
+                    bytes >> 20,
+                    MAX_MULTISAMPLE_TARGET_BYTES >> 20
+                ),
+            });
+        }
         let grid = TileGrid::band(
             width,
             height,
@@ -257,9 +375,19 @@ impl Framebuffer {
                 bytes: grid.tile_count() * std::mem::size_of::<TileBuffer>(),
             })?;
         for _ in 0..grid.tile_count() {
-            tiles.push(TileBuffer::new()?);
+            tiles.push(TileBuffer::new(samples)?);
         }
-        Ok(Self { grid, tiles, rows })
+        Ok(Self {
+            grid,
+            tiles,
+            rows,
+            samples,
+        })
+    }
+
+    /// Samples per pixel.
+    pub fn samples(&self) -> SampleCount {
+        self.samples
     }
 
     /// Width in pixels.
@@ -343,7 +471,8 @@ impl Framebuffer {
     }
 
     /// Streams window depth a row at a time: `emit(y, row)` with `row` holding `width` values,
-    /// row 0 = top. Needs one row of memory.
+    /// row 0 = top (on a multisampled target the depth at the pixel centres, equal to a 1×
+    /// render's). Needs one row of memory.
     pub fn read_depth_rows(&self, emit: impl FnMut(u32, &[f32])) {
         self.read_rows(1, |t, i, out| out[0] = t.depth[i], emit);
     }
@@ -479,7 +608,7 @@ mod tests {
 
     #[test]
     fn framebuffer_reads_back_row_major() {
-        let mut fb = Framebuffer::new(70, 3).expect("small target");
+        let mut fb = Framebuffer::new(70, 3, SampleCount::X1).expect("small target");
         fb.clear(Some(Vec4::ONE), Some(0.25));
         let c = fb.read_color();
         assert_eq!(c.len(), 210);

@@ -121,7 +121,8 @@ pub struct TriangleSetup {
     pub edges: [EdgeFunction; 3],
     /// Twice the signed area in sub-pixel units squared (> 0 after orientation).
     pub area2: i64,
-    /// Pixels whose centres may be covered, clamped to the target.
+    /// Pixels whose centres (on a multisampled target: whose samples) may be covered, clamped
+    /// to the target.
     pub bbox: PixelRect,
     /// Snapped vertex positions (sub-pixel units), after orientation.
     pub pos_subpixel: [[i64; 2]; 3],
@@ -187,6 +188,9 @@ pub struct Viewport {
     pub width: u32,
     /// Target height in pixels.
     pub height: u32,
+    /// How far (sub-pixel units) the samples of a multisampled target lie from their pixel
+    /// centre at most: a triangle's pixel box reaches that much further (0 at 1×).
+    sample_reach: i64,
 }
 
 impl Viewport {
@@ -197,6 +201,17 @@ impl Viewport {
             half_height: height as f32 * 0.5,
             width,
             height,
+            sample_reach: 0,
+        }
+    }
+
+    /// The same viewport for a target with `samples` samples per pixel: triangles' pixel boxes
+    /// then hold every pixel one of whose samples they may cover, and a triangle that covers a
+    /// sample but no pixel centre is kept.
+    pub fn with_samples(self, samples: crate::multisample::SampleCount) -> Self {
+        Self {
+            sample_reach: samples.reach_subpixel(),
+            ..self
         }
     }
 
@@ -324,12 +339,14 @@ pub fn setup_window_triangle(
         EdgeFunction::new(p(2), p(0)),
         EdgeFunction::new(p(0), p(1)),
     ];
-    // Pixel x is a candidate when its centre x·256 + 128 lies within [min, max]; an arithmetic
-    // shift is the floor division by 256.
-    let min_x = pos[0][0].min(pos[1][0]).min(pos[2][0]);
-    let max_x = pos[0][0].max(pos[1][0]).max(pos[2][0]);
-    let min_y = pos[0][1].min(pos[1][1]).min(pos[2][1]);
-    let max_y = pos[0][1].max(pos[1][1]).max(pos[2][1]);
+    // Pixel x is a candidate when its centre x·256 + 128 lies within [min, max] (widened by
+    // the sample reach of a multisampled target); an arithmetic shift is the floor division
+    // by 256.
+    let reach = viewport.sample_reach;
+    let min_x = pos[0][0].min(pos[1][0]).min(pos[2][0]) - reach;
+    let max_x = pos[0][0].max(pos[1][0]).max(pos[2][0]) + reach;
+    let min_y = pos[0][1].min(pos[1][1]).min(pos[2][1]) - reach;
+    let max_y = pos[0][1].max(pos[1][1]).max(pos[2][1]) + reach;
     let half = crate::fixed::SUBPIXEL_HALF;
     let bits = crate::fixed::SUBPIXEL_BITS;
     let first = |min: i64| (min - half + SUBPIXEL_ONE - 1) >> bits;

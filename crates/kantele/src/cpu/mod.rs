@@ -6,6 +6,7 @@ use std::sync::Arc;
 use crate::backend::{Backend, FrameImage, FrameView, Pass};
 use crate::error::RenderError;
 use crate::material::{Lighting, MaterialShader, StandardVertex};
+use crate::multisample::SampleCount;
 use crate::pipeline::{Indices, RenderState, Renderer, RendererOptions};
 use crate::raster::Strategy;
 use crate::scene::{Mesh, Scene, Topology};
@@ -35,6 +36,8 @@ impl PreparedMesh {
 /// Renders scenes with Kantele's CPU pipeline.
 pub struct CpuBackend {
     renderer: Renderer,
+    /// Samples per pixel of colour frames.
+    samples: SampleCount,
     scene: Option<(Arc<Scene>, Vec<PreparedMesh>)>,
     /// The rows frames are restricted to (`None`: whole frames).
     region: Option<std::ops::Range<u32>>,
@@ -45,6 +48,7 @@ impl CpuBackend {
     pub fn new(options: CpuOptions) -> Result<Self, RenderError> {
         Ok(Self {
             renderer: Renderer::new(1, 1, options)?,
+            samples: options.samples,
             scene: None,
             region: None,
         })
@@ -123,6 +127,16 @@ impl Backend for CpuBackend {
         let Some((scene, meshes)) = &self.scene else {
             return Err(RenderError::InvalidScene("no scene loaded".into()));
         };
+        // Ids and normals are never averaged: those passes render at 1×.
+        let samples = match view.pass {
+            Pass::Color => self.samples,
+            Pass::Normals | Pass::Ids => SampleCount::X1,
+        };
+        if samples != self.renderer.samples() {
+            // Re-created at the new size (the 1 × 1 target first keeps the switch cheap).
+            self.renderer.resize(1, 1)?;
+            self.renderer.set_samples(samples)?;
+        }
         let rows = self.region.clone().unwrap_or(0..view.height);
         self.renderer.resize_band(view.width, view.height, rows)?;
         let view_projection = view.projection * view.view;
@@ -178,6 +192,15 @@ impl Backend for CpuBackend {
             )?;
         }
         frame.try_end()
+    }
+
+    fn set_samples(&mut self, samples: SampleCount) -> Result<(), RenderError> {
+        self.samples = samples;
+        Ok(())
+    }
+
+    fn samples(&self) -> SampleCount {
+        self.samples
     }
 
     fn read_frame(&mut self) -> Result<FrameImage, RenderError> {

@@ -5,8 +5,10 @@ use glam::Vec4;
 
 use super::fragment::{shade_triangle, RasterCounters};
 use super::geometry::{PrimitiveBatch, ShadedVertices, TargetSpace};
+use super::multisample::shade_triangle_multisampled;
 use super::shader::Shader;
 use crate::geometry::clip::{classify_codes, ClipCode, ClipPolygon, ClipTest, ClipVertex};
+use crate::raster::samples::SampleCoverage;
 use crate::raster::BlockCoverage;
 use crate::rop::{DepthFunc, TileBuffer};
 use crate::setup::{setup_window_triangle, SetupReject, TriangleSetup, Viewport, WindowVertex};
@@ -72,6 +74,15 @@ pub(super) trait DrawJob: Sync {
         tri: &TriangleSetup,
         attrs: &[f32],
         coverage: &BlockCoverage,
+        tile: &mut TileBuffer,
+        isa: Isa,
+    ) -> RasterCounters;
+    /// Shades the triangle's covered samples in `coverage` into one multisampled tile.
+    fn raster_multisampled(
+        &self,
+        tri: &TriangleSetup,
+        attrs: &[f32],
+        coverage: &SampleCoverage,
         tile: &mut TileBuffer,
         isa: Isa,
     ) -> RasterCounters;
@@ -244,5 +255,16 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
         isa: Isa,
     ) -> RasterCounters {
         shade_triangle(self, tri, attrs, coverage, tile, isa)
+    }
+
+    fn raster_multisampled(
+        &self,
+        tri: &TriangleSetup,
+        attrs: &[f32],
+        coverage: &SampleCoverage,
+        tile: &mut TileBuffer,
+        isa: Isa,
+    ) -> RasterCounters {
+        shade_triangle_multisampled(self, tri, attrs, coverage, tile, isa)
     }
 }

@@ -56,6 +56,17 @@ pub(super) fn raster_tiles(
     isa: Isa,
     budget: &FrameBudget<'_>,
 ) -> RasterCounters {
+    if framebuffer.samples().is_multisampled() {
+        return super::multisample::raster_tiles_multisampled(
+            framebuffer,
+            bins,
+            geometry,
+            draws,
+            strategy,
+            isa,
+            budget,
+        );
+    }
     let grid = *framebuffer.grid();
     framebuffer
         .tiles_mut()

@@ -17,6 +17,7 @@ mod budget;
 mod draw;
 mod fragment;
 mod geometry;
+mod multisample;
 mod points_lines;
 mod sanitize;
 mod shader;
@@ -35,6 +36,7 @@ use self::budget::FrameBudget;
 use self::draw::{DrawCall, DrawJob};
 use self::geometry::{run_geometry, GeometryScratch};
 use crate::error::RenderError;
+use crate::multisample::SampleCount;
 use crate::raster::bin::TileBins;
 use crate::raster::Strategy;
 use crate::rop::Framebuffer;
@@ -57,6 +59,9 @@ pub struct RendererOptions {
     /// out stops between chunks of work, leaves the picture partly drawn and reports
     /// [`FrameStop::TimedOut`] ([`Frame::try_end`]: [`RenderError::TimedOut`]).
     pub timeout: Option<Duration>,
+    /// Samples per pixel of the target (multisample antialiasing; see
+    /// [`crate::multisample`]). The default, 1×, is the single-sample path.
+    pub samples: SampleCount,
 }
 
 /// The CPU renderer: owns the framebuffer and the worker threads.
@@ -84,7 +89,7 @@ impl Renderer {
                 message: format!("cannot start worker threads: {e}"),
             })?;
         Ok(Self {
-            framebuffer: Framebuffer::new(width, height)?,
+            framebuffer: Framebuffer::new(width, height, options.samples)?,
             pool,
             strategy: options.strategy,
             isa: resolve_isa(options.isa),
@@ -121,9 +126,28 @@ impl Renderer {
         }
         let fb = &self.framebuffer;
         if (width, height, rows.clone()) != (fb.width(), fb.height(), fb.rows()) {
+            let samples = fb.samples();
             // Free the old target first: two big targets need not fit at once.
-            self.framebuffer = Framebuffer::new(1, 1)?;
-            self.framebuffer = Framebuffer::band(width, height, rows)?;
+            self.framebuffer = Framebuffer::new(1, 1, samples)?;
+            self.framebuffer = Framebuffer::band(width, height, rows, samples)?;
+        }
+        Ok(())
+    }
+
+    /// Samples per pixel of the target.
+    pub fn samples(&self) -> SampleCount {
+        self.framebuffer.samples()
+    }
+
+    /// Changes the samples per pixel (contents become undefined: clear before drawing); an
+    /// error when the multisampled target would be too large (see
+    /// [`crate::multisample::MAX_MULTISAMPLE_TARGET_BYTES`]).
+    pub fn set_samples(&mut self, samples: SampleCount) -> Result<(), RenderError> {
+        if samples != self.framebuffer.samples() {
+            let fb = &self.framebuffer;
+            let (width, height, rows) = (fb.width(), fb.height(), fb.rows());
+            self.framebuffer = Framebuffer::new(1, 1, samples)?;
+            self.framebuffer = Framebuffer::band(width, height, rows, samples)?;
         }
         Ok(())
     }
@@ -322,7 +346,8 @@ impl<'a> Frame<'_, 'a> {
                 return;
             }
             framebuffer.clear(clear_color, clear_depth);
-            let viewport = Viewport::new(framebuffer.width(), framebuffer.height());
+            let viewport = Viewport::new(framebuffer.width(), framebuffer.height())
+                .with_samples(framebuffer.samples());
             let geometry_start = Instant::now();
             run_geometry(&draws, &viewport, &mut stats, scratch, &budget);
             let geometry = scratch.output();

@@ -7,6 +7,7 @@
 //! three edges, each once.
 
 pub mod bin;
+pub mod samples;
 
 use std::str::FromStr;
 
