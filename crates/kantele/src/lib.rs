@@ -80,6 +80,7 @@
 //! - [`raster`] — binning into tiles ([`raster::bin`]) and the five traversal strategies.
 //! - [`shade`] — textures, samplers, mip chains and level of detail.
 //! - [`rop`] — depth test, blending, and the tiled framebuffer.
+//! - [`multisample`] — multisample antialiasing: sample counts, standard positions, limits.
 //! - [`stats`] — per-stage counters and timings of a frame.
 //!
 //! Scenes and backends:

@@ -189,6 +189,11 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                 let mut centre = [zero; 3];
                 let mut any = none;
                 for plane in 0..planes {
+                    let bits = (coverage.mask(plane, block.index) >> (8 * row)) as u8;
+                    // An uncovered sample needs nothing; the centre's values feed shading.
+                    if bits == 0 && plane != 0 {
+                        continue;
+                    }
                     let [ox, oy] = offsets[plane];
                     let dx = (lanes.splat_i32((centre_dx + ox) as i32) + lane_offset).to_f32();
                     let dy = lanes.splat_f32((centre_dy + oy) as f32);
@@ -200,7 +205,6 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                     if plane == 0 {
                         centre = [l0, l1, l2];
                     }
-                    let bits = (coverage.mask(plane, block.index) >> (8 * row)) as u8;
                     if bits == 0 {
                         continue;
                     }
