@@ -733,8 +733,15 @@ __device__ bool shade_fragment(const FrameUniforms& f, const SceneView& s, const
         out = auxiliary(f, d, in, t);
         return true;
     }
+    // Emission (`MaterialShader::emissive`): factor × emissive texture, added after lighting
+    // (and to the unlit colour).
+    V3 e = {d.emissive[0], d.emissive[1], d.emissive[2]};
+    if (d.flags & KANTELE_DRAW_EMISSIVE_TEXTURED) {
+        V4 sample = sample_grad(s, t, attrs, in, d.emissive_texture, d.emissive_sampler);
+        e = {mul(e.x, sample.x), mul(e.y, sample.y), mul(e.z, sample.z)};
+    }
     if (d.flags & KANTELE_DRAW_UNLIT) {
-        out = {base.x, base.y, base.z, alpha};
+        out = {add(base.x, e.x), add(base.y, e.y), add(base.z, e.z), alpha};
         return true;
     }
     V3 n = material_normal(d, in, (t.flags & KANTELE_TRIANGLE_FRONT_FACING) != 0);
@@ -742,12 +749,6 @@ __device__ bool shade_fragment(const FrameUniforms& f, const SceneView& s, const
     float k = mul(sub(1.0f, f.ambient), n_dot_l);
     V3 light = {add(f.ambient, mul(k, f.light_color[0])), add(f.ambient, mul(k, f.light_color[1])),
                 add(f.ambient, mul(k, f.light_color[2]))};
-    // Emission (`MaterialShader::emissive`): factor × emissive texture, added after lighting.
-    V3 e = {d.emissive[0], d.emissive[1], d.emissive[2]};
-    if (d.flags & KANTELE_DRAW_EMISSIVE_TEXTURED) {
-        V4 sample = sample_grad(s, t, attrs, in, d.emissive_texture, d.emissive_sampler);
-        e = {mul(e.x, sample.x), mul(e.y, sample.y), mul(e.z, sample.z)};
-    }
     out = {add(mul(base.x, light.x), e.x), add(mul(base.y, light.y), e.y),
            add(mul(base.z, light.z), e.z), alpha};
     return true;

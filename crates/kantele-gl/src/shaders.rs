@@ -88,12 +88,12 @@ void main() {
     vec3 rgb = base.rgb;
     if (!u_unlit) {
         rgb = base.rgb * (u_ambient + (1.0 - u_ambient) * max(0.0, dot(n, u_to_light)) * u_light_color);
-        vec3 emissive = u_emissive;
-        if (u_has_emissive_texture) {
-            emissive *= texture(u_emissive_texture, v_texcoord).rgb;
-        }
-        rgb += emissive;
     }
+    vec3 emissive = u_emissive;
+    if (u_has_emissive_texture) {
+        emissive *= texture(u_emissive_texture, v_texcoord).rgb;
+    }
+    rgb += emissive;
     float a = u_alpha_mode == 2 ? base.a : 1.0;
     o_color = vec4(rgb, a);
 }

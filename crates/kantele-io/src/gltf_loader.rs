@@ -684,6 +684,12 @@ impl Loader<'_> {
             },
             gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         };
+        if material.unlit() {
+            // KHR_materials_unlit: every property but the base colour is a fallback for viewers
+            // without the extension; the unlit shading adds emission, so drop it here.
+            emissive = Vec3::ZERO;
+            emissive_texture = None;
+        }
         Ok(Material {
             name: material.name().unwrap_or_default().to_string(),
             base_color_factor: Vec4::from(pbr.base_color_factor()),

@@ -622,3 +622,31 @@ fn an_orthographic_square_stays_square() {
     assert_eq!((span(|p| p.0), span(|p| p.1)), (60, 60));
     assert_eq!(pixels.len(), 3600);
 }
+
+#[test]
+fn a_line_without_normals_is_base_colour_plus_emissive() {
+    // glTF: points and lines without normals are drawn unlit as base colour + emissive. The
+    // same emission on a KHR_materials_unlit material is only a fallback and is not added.
+    for (unlit_extension, want) in [(false, [0.7, 0.2, 0.2]), (true, [0.2, 0.2, 0.2])] {
+        let mut material = json!({
+            "pbrMetallicRoughness": {"baseColorFactor": [0.2, 0.2, 0.2, 1.0]},
+            "emissiveFactor": [0.5, 0.0, 0.0]
+        });
+        if unlit_extension {
+            material["extensions"] = json!({"KHR_materials_unlit": {}});
+        }
+        let mut g =
+            pixel_grid_scene(json!({"attributes": {"POSITION": 0}, "mode": 1, "material": 0}));
+        g.material(material);
+        g.vec3(&[pixel_centre(10, 49), pixel_centre(140, 29)]);
+        let loaded = load(&write(&g, &format!("emissive-line-{unlit_extension}")));
+        let image = render_posed(&loaded.scene);
+        let c = pixel(&image, 10, 49);
+        for k in 0..3 {
+            assert!(
+                (c[k] - want[k]).abs() < 1e-6,
+                "unlit extension {unlit_extension}: {c}"
+            );
+        }
+    }
+}

@@ -1,8 +1,8 @@
 //! Built-in materials: shaders implementing exactly the shading rules of the reference scenes,
 //! so a loaded scene draws without user shaders.
 //!
-//! `base = baseColorFactor × COLOR_0 × texture(uv)`; unlit → `base`; otherwise Lambert
-//! `base.rgb × (ambient + (1 − ambient) × max(0, N·L) × light)`, with `N` the interpolated
+//! `base = baseColorFactor × COLOR_0 × texture(uv)`; unlit → `base + emissive`; otherwise Lambert
+//! `base.rgb × (ambient + (1 − ambient) × max(0, N·L) × light) + emissive`, with `N` the interpolated
 //! world normal renormalised per pixel and flipped on back faces of double-sided materials.
 //! Alpha: OPAQUE → 1, MASK → discard below the cutoff, BLEND → blended by the draw's state.
 
@@ -194,14 +194,14 @@ impl Shader for MaterialShader<'_> {
         if self.pass != Pass::Color {
             return Some(self.auxiliary(fragment));
         }
+        // --- emissive (loaders work): added after lighting, and to unlit colour ---
+        let emissive = self.emissive(fragment);
         if self.material.unlit {
-            return Some(base.truncate().extend(alpha));
+            return Some((base.truncate() + emissive).extend(alpha));
         }
         let l = self.lighting;
         let n_dot_l = self.normal(fragment).dot(l.to_light).max(0.0);
         let light = Vec3::splat(l.ambient) + (1.0 - l.ambient) * n_dot_l * l.light_color;
-        // --- emissive (loaders work): added after lighting ---
-        let emissive = self.emissive(fragment);
         Some((base.truncate() * light + emissive).extend(alpha))
     }
 
@@ -267,8 +267,14 @@ impl MaterialShader<'_> {
             };
         }
         if self.material.unlit {
+            let emissive = self.emissive_lanes(f);
             return ShadedLanes {
-                color: [base[0], base[1], base[2], alpha],
+                color: [
+                    base[0] + emissive[0],
+                    base[1] + emissive[1],
+                    base[2] + emissive[2],
+                    alpha,
+                ],
                 keep,
             };
         }

@@ -137,10 +137,12 @@ pub struct Material {
     pub double_sided: bool,
     /// Alpha handling.
     pub alpha_mode: AlphaMode,
-    /// `KHR_materials_unlit`: colour = base colour.
+    /// Unlit: colour = base colour + emission, no lighting (`KHR_materials_unlit`, whose
+    /// materials the loader gives no emission, and lines and points without normals, which glTF
+    /// draws as base + emissive).
     pub unlit: bool,
     /// Linear emitted colour (`emissiveFactor` × `KHR_materials_emissive_strength`), added after
-    /// lighting (lit materials only).
+    /// lighting.
     pub emissive: Vec3,
     /// sRGB emissive texture, multiplied into `emissive`; read with the base colour's
     /// texture coordinates.
