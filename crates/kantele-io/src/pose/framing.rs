@@ -170,6 +170,57 @@ fn check_size(width: u32, height: u32) -> Result<f64, PoseError> {
     Ok(width as f64 / height as f64)
 }
 
+/// A box seen from a framing direction: the camera basis the framed camera will have
+/// ([`look_at_f64`] picks the same) and the box's corners in it, relative to the box's centre in
+/// units of its radius.
+struct BoxInView {
+    /// Unit vector from the box towards the eye.
+    back: DVec3,
+    /// The camera's right and up axes.
+    right: DVec3,
+    cam_up: DVec3,
+    /// The box's centre and radius (world units).
+    center: DVec3,
+    scale: f64,
+    /// Corners as (right, up, back) coordinates, in radii from the centre.
+    corners: [DVec3; 8],
+}
+
+impl BoxInView {
+    fn new(bounds: &Bounds, from_dir: Vec3, up: UpAxis) -> Result<Self, PoseError> {
+        if !bounds.min.is_finite() || !bounds.max.is_finite() {
+            return Err(err("the bounds to frame are not finite"));
+        }
+        let back = unit(from_dir.as_dvec3())
+            .ok_or_else(|| err(format!("framing direction {from_dir} is not a direction")))?;
+        let up_hint = if back.cross(up.vector()).length_squared() < 1e-12 {
+            if back.cross(DVec3::Z).length_squared() < 1e-12 {
+                DVec3::Y
+            } else {
+                DVec3::Z
+            }
+        } else {
+            up.vector()
+        };
+        let right = up_hint.cross(back).normalize();
+        let cam_up = back.cross(right);
+        let scale = bounds.scale();
+        let center = bounds.center();
+        let corners = bounds.corners().map(|p| {
+            let q = (p - center) / scale;
+            DVec3::new(q.dot(right), q.dot(cam_up), q.dot(back))
+        });
+        Ok(Self {
+            back,
+            right,
+            cam_up,
+            center,
+            scale,
+            corners,
+        })
+    }
+}
+
 impl CameraPose {
     /// A perspective camera that looks at `bounds` from direction `from_dir` (centre towards
     /// the eye) and makes the box fill the picture: every corner inside the image and the box
@@ -185,31 +236,14 @@ impl CameraPose {
     ) -> Result<Self, PoseError> {
         let yfov_f = check_yfov(yfov)?;
         let aspect = check_size(width, height)?;
-        if !bounds.min.is_finite() || !bounds.max.is_finite() {
-            return Err(err("the bounds to frame are not finite"));
-        }
-        let back = unit(from_dir.as_dvec3())
-            .ok_or_else(|| err(format!("framing direction {from_dir} is not a direction")))?;
-        // A basis as the camera will have it (look_at_f64 picks the same).
-        let up_hint = if back.cross(up.vector()).length_squared() < 1e-12 {
-            if back.cross(DVec3::Z).length_squared() < 1e-12 {
-                DVec3::Y
-            } else {
-                DVec3::Z
-            }
-        } else {
-            up.vector()
-        };
-        let right = up_hint.cross(back).normalize();
-        let cam_up = back.cross(right);
-
-        // Work relative to the box, in units of its radius.
-        let scale = bounds.scale();
-        let center = bounds.center();
-        let corners = bounds.corners().map(|p| {
-            let q = (p - center) / scale;
-            DVec3::new(q.dot(right), q.dot(cam_up), q.dot(back))
-        });
+        let BoxInView {
+            back,
+            right,
+            cam_up,
+            center,
+            scale,
+            corners,
+        } = BoxInView::new(bounds, from_dir, up)?;
         let ty = (0.5 * yfov_f).tan() * FRAMING_FILL;
         let tx = (0.5 * yfov_f).tan() * aspect * FRAMING_FILL;
         // Target offset in the image plane (right, up), re-centred a few times.
@@ -272,28 +306,14 @@ impl CameraPose {
         height: u32,
     ) -> Result<Self, PoseError> {
         let aspect = check_size(width, height)?;
-        if !bounds.min.is_finite() || !bounds.max.is_finite() {
-            return Err(err("the bounds to frame are not finite"));
-        }
-        let back = unit(from_dir.as_dvec3())
-            .ok_or_else(|| err(format!("framing direction {from_dir} is not a direction")))?;
-        let up_hint = if back.cross(up.vector()).length_squared() < 1e-12 {
-            if back.cross(DVec3::Z).length_squared() < 1e-12 {
-                DVec3::Y
-            } else {
-                DVec3::Z
-            }
-        } else {
-            up.vector()
-        };
-        let right = up_hint.cross(back).normalize();
-        let cam_up = back.cross(right);
-        let scale = bounds.scale();
-        let center = bounds.center();
-        let corners = bounds.corners().map(|p| {
-            let q = (p - center) / scale;
-            DVec3::new(q.dot(right), q.dot(cam_up), q.dot(back))
-        });
+        let BoxInView {
+            back,
+            right,
+            cam_up,
+            center,
+            scale,
+            corners,
+        } = BoxInView::new(bounds, from_dir, up)?;
         let fold = |f: fn(&DVec3) -> f64, pick: fn(f64, f64) -> f64, start: f64| {
             corners.iter().map(f).fold(start, pick)
         };
