@@ -126,6 +126,81 @@ pub(super) fn shade_triangle<S: Shader>(
     )
 }
 
+/// A triangle's per-pixel constants splatted across the lanes, and the steps every lane kernel
+/// (1× and multisampled) takes per row in the same order, so all give the same bits.
+pub(super) struct TriangleLanes<L: Lanes> {
+    /// `TriangleSetup::bary_gradient` of λ1 and λ2.
+    g1: [L::F32; 2],
+    g2: [L::F32; 2],
+    /// Window depth and `1/w` per vertex, and the depth range.
+    z: [L::F32; 3],
+    z_range: [L::F32; 2],
+    inv_w: [L::F32; 3],
+    /// Sub-pixel offsets of the eight lanes' centres from lane 0's.
+    lane_offset: L::I32,
+    /// 0 and 1 in every lane.
+    pub(super) zero: L::F32,
+    pub(super) one: L::F32,
+}
+
+impl<L: Lanes> TriangleLanes<L> {
+    #[inline(always)]
+    pub(super) fn new(lanes: L, tri: &TriangleSetup) -> Self {
+        let g = tri.bary_gradient;
+        Self {
+            g1: [lanes.splat_f32(g[0][0]), lanes.splat_f32(g[0][1])],
+            g2: [lanes.splat_f32(g[1][0]), lanes.splat_f32(g[1][1])],
+            z: [
+                lanes.splat_f32(tri.depth[0]),
+                lanes.splat_f32(tri.depth[1]),
+                lanes.splat_f32(tri.depth[2]),
+            ],
+            z_range: [
+                lanes.splat_f32(tri.depth_range[0]),
+                lanes.splat_f32(tri.depth_range[1]),
+            ],
+            inv_w: [
+                lanes.splat_f32(tri.inv_w[0]),
+                lanes.splat_f32(tri.inv_w[1]),
+                lanes.splat_f32(tri.inv_w[2]),
+            ],
+            lane_offset: lanes
+                .lane_index()
+                .shl::<{ crate::fixed::SUBPIXEL_BITS as i32 }>(),
+            zero: lanes.splat_f32(0.0),
+            one: lanes.splat_f32(1.0),
+        }
+    }
+
+    /// Barycentrics `[λ0, λ1, λ2]` of the eight lanes whose first lies `(dx, dy)` sub-pixel
+    /// units from vertex 0 (`TriangleSetup::barycentrics`): the offsets are exact integers
+    /// (|d| < 2^31), converted to f32 with round-to-nearest-even.
+    #[inline(always)]
+    pub(super) fn barycentrics(&self, lanes: L, dx: i64, dy: i64) -> [L::F32; 3] {
+        let dx = (lanes.splat_i32(dx as i32) + self.lane_offset).to_f32();
+        let dy = lanes.splat_f32(dy as f32);
+        let l1 = self.g1[0] * dx + self.g1[1] * dy;
+        let l2 = self.g2[0] * dx + self.g2[1] * dy;
+        [self.one - l1 - l2, l1, l2]
+    }
+
+    /// Affine depth, clamped to the vertex range (`TriangleSetup::depth_at`).
+    #[inline(always)]
+    pub(super) fn depth(&self, [l0, l1, l2]: [L::F32; 3]) -> L::F32 {
+        (l0 * self.z[0] + l1 * self.z[1] + l2 * self.z[2])
+            .max(self.z_range[0])
+            .min(self.z_range[1])
+    }
+
+    /// Perspective-correct weights and `w` from screen-space barycentrics.
+    #[inline(always)]
+    pub(super) fn perspective_weights(&self, [l0, l1, l2]: [L::F32; 3]) -> ([L::F32; 3], L::F32) {
+        let q = [l0 * self.inv_w[0], l1 * self.inv_w[1], l2 * self.inv_w[2]];
+        let w = self.one / (q[0] + q[1] + q[2]);
+        ([q[0] * w, q[1] * w, q[2] * w], w)
+    }
+}
+
 /// One triangle in one tile, as a kernel compiled per instruction set.
 struct ShadeTriangle<'k, 'a, S: Shader> {
     draw: &'k DrawCall<'a, S>,
@@ -157,23 +232,9 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
             dl_dx,
             dl_dy,
         };
-        let splat = |v: f32| lanes.splat_f32(v);
-        let g = tri.bary_gradient;
-        let (g1x, g1y, g2x, g2y) = (
-            splat(g[0][0]),
-            splat(g[0][1]),
-            splat(g[1][0]),
-            splat(g[1][1]),
-        );
-        let z = tri.depth.map(splat);
-        let (z_min, z_max) = (splat(tri.depth_range[0]), splat(tri.depth_range[1]));
-        let inv_w = tri.inv_w.map(splat);
-        let (zero, one) = (splat(0.0), splat(1.0));
+        let triangle = TriangleLanes::new(lanes, tri);
+        let (zero, one) = (triangle.zero, triangle.one);
         let [v0x, v0y] = tri.pos_subpixel[0];
-        // Sub-pixel offsets of the eight lanes' centres from lane 0's.
-        let lane_offset = lanes
-            .lane_index()
-            .shl::<{ crate::fixed::SUBPIXEL_BITS as i32 }>();
         let mut counters = RasterCounters::default();
         let blocks_can_reject = draw.rejects_by_depth_bound();
 
@@ -193,16 +254,12 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 }
                 counters.covered += row_bits.count_ones() as u64;
                 let (x, y) = (block.x, block.y + row);
-                // Barycentrics from vertex 0 (`TriangleSetup::barycentrics`): the offsets are
-                // exact integers (|d| < 2^31), converted to f32 with round-to-nearest-even.
-                let dx =
-                    (lanes.splat_i32((pixel_center(x as i64) - v0x) as i32) + lane_offset).to_f32();
-                let dy = lanes.splat_f32((pixel_center(y as i64) - v0y) as f32);
-                let l1 = g1x * dx + g1y * dy;
-                let l2 = g2x * dx + g2y * dy;
-                let l0 = one - l1 - l2;
-                // Affine depth, clamped to the vertex range (`TriangleSetup::depth_at`).
-                let depth = (l0 * z[0] + l1 * z[1] + l2 * z[2]).max(z_min).min(z_max);
+                let bary = triangle.barycentrics(
+                    lanes,
+                    pixel_center(x as i64) - v0x,
+                    pixel_center(y as i64) - v0y,
+                );
+                let depth = triangle.depth(bary);
                 // Outside [0, 1] (or NaN): beyond the near or far plane.
                 let mut active = lanes
                     .mask_from_bits(row_bits)
@@ -216,9 +273,7 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 if active.none() {
                     continue;
                 }
-                // Perspective-correct weights.
-                let q = [l0 * inv_w[0], l1 * inv_w[1], l2 * inv_w[2]];
-                let w = one / (q[0] + q[1] + q[2]);
+                let (weights, w) = triangle.perspective_weights(bary);
                 let fragments = FragmentLanes {
                     lanes,
                     x: x as u32,
@@ -227,7 +282,7 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                     depth,
                     primitive_id: tri.primitive_id,
                     front_facing: tri.front_facing(),
-                    weights: [q[0] * w, q[1] * w, q[2] * w],
+                    weights,
                     w,
                     interpolation: &interpolation,
                 };

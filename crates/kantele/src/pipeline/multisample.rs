@@ -19,7 +19,7 @@ use rayon::prelude::*;
 
 use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::draw::{DrawCall, DrawJob};
-use super::fragment::RasterCounters;
+use super::fragment::{RasterCounters, TriangleLanes};
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
 use super::shader::{FragmentLanes, Interpolation, Shader};
@@ -29,7 +29,7 @@ use crate::raster::samples::{rasterize_samples, SampleCoverage, MAX_COVERAGE_PLA
 use crate::raster::Strategy;
 use crate::rop::{Framebuffer, TileBuffer};
 use crate::setup::TriangleSetup;
-use crate::simd::{dispatch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
+use crate::simd::{dispatch, F32x8, Isa, LaneKernel, Lanes, Mask8};
 
 /// Rasterizes every tile's bin into a multisampled framebuffer, tiles in parallel, each tile's
 /// triangles in order.
@@ -133,32 +133,9 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
             dl_dx,
             dl_dy,
         };
-        let g = tri.bary_gradient;
-        let (g1x, g1y, g2x, g2y) = (
-            lanes.splat_f32(g[0][0]),
-            lanes.splat_f32(g[0][1]),
-            lanes.splat_f32(g[1][0]),
-            lanes.splat_f32(g[1][1]),
-        );
-        let z = [
-            lanes.splat_f32(tri.depth[0]),
-            lanes.splat_f32(tri.depth[1]),
-            lanes.splat_f32(tri.depth[2]),
-        ];
-        let (z_min, z_max) = (
-            lanes.splat_f32(tri.depth_range[0]),
-            lanes.splat_f32(tri.depth_range[1]),
-        );
-        let inv_w = [
-            lanes.splat_f32(tri.inv_w[0]),
-            lanes.splat_f32(tri.inv_w[1]),
-            lanes.splat_f32(tri.inv_w[2]),
-        ];
-        let (zero, one) = (lanes.splat_f32(0.0), lanes.splat_f32(1.0));
+        let triangle = TriangleLanes::new(lanes, tri);
+        let (zero, one) = (triangle.zero, triangle.one);
         let [v0x, v0y] = tri.pos_subpixel[0];
-        let lane_offset = lanes
-            .lane_index()
-            .shl::<{ crate::fixed::SUBPIXEL_BITS as i32 }>();
         let planes = coverage.planes();
         let samples = planes - 1;
         let offsets = tile_sample_offsets(samples);
@@ -195,15 +172,11 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                         continue;
                     }
                     let [ox, oy] = offsets[plane];
-                    let dx = (lanes.splat_i32((centre_dx + ox) as i32) + lane_offset).to_f32();
-                    let dy = lanes.splat_f32((centre_dy + oy) as f32);
-                    let l1 = g1x * dx + g1y * dy;
-                    let l2 = g2x * dx + g2y * dy;
-                    let l0 = one - l1 - l2;
-                    let depth = (l0 * z[0] + l1 * z[1] + l2 * z[2]).max(z_min).min(z_max);
+                    let bary = triangle.barycentrics(lanes, centre_dx + ox, centre_dy + oy);
+                    let depth = triangle.depth(bary);
                     depths[plane] = depth;
                     if plane == 0 {
-                        centre = [l0, l1, l2];
+                        centre = bary;
                     }
                     if bits == 0 {
                         continue;
@@ -223,9 +196,7 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                     continue;
                 }
                 // One shading per pixel, at the pixel centre (perspective-correct weights).
-                let [l0, l1, l2] = centre;
-                let q = [l0 * inv_w[0], l1 * inv_w[1], l2 * inv_w[2]];
-                let w = one / (q[0] + q[1] + q[2]);
+                let (weights, w) = triangle.perspective_weights(centre);
                 let fragments = FragmentLanes {
                     lanes,
                     x: x as u32,
@@ -234,7 +205,7 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                     depth: depths[0].max(zero).min(one),
                     primitive_id: tri.primitive_id,
                     front_facing: tri.front_facing(),
-                    weights: [q[0] * w, q[1] * w, q[2] * w],
+                    weights,
                     w,
                     interpolation: &interpolation,
                 };
