@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use kantele::compare::{compare, edge_mask, Comparison};
+use kantele_io::compare::{compare, edge_mask, Comparison};
 
 mod common;
 

@@ -7,11 +7,11 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
-use kantele::compare::{compare, edge_mask, Comparison};
 use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::multisample::SampleCount;
 use kantele::scene::Scene;
 use kantele::RenderError;
+use kantele_io::compare::{compare, edge_mask, Comparison};
 
 mod common;
 
