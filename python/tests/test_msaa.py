@@ -85,3 +85,24 @@ def test_an_unsupported_sample_count_is_a_one_line_value_error(msaa):
     assert "\n" not in str(e.value)
     with pytest.raises(ValueError, match="msaa"):
         scene.render_many([CAMERA], msaa=msaa)
+
+
+def test_the_ray_renderer_passes_msaa_on(tmp_path):
+    # Renderer.render_rows is plain Python: no Ray needed to check what it renders.
+    from kantele.ray import Renderer
+
+    path = tmp_path / "quad.obj"
+    # Both windings: one side or the other faces every orbit camera.
+    path.write_text("v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\nf 1 3 2\nf 1 4 3\n")
+    batch = {"scene": np.array([str(path)]), "views": np.array([3]), "view": np.array([1])}
+    scene = kantele.load(path)
+    camera = scene.orbit_cameras(3, size=SIZE)[1]
+    for msaa in (1, 4):
+        [(_, view, _, arrays)] = Renderer(SIZE, outputs=("color",), msaa=msaa).render_rows(batch)
+        expected = scene.render(camera=camera, size=SIZE, outputs=("color",), msaa=msaa)
+        assert view == 1
+        np.testing.assert_array_equal(arrays["color"], expected["color"])
+    one = Renderer(SIZE, outputs=("color",)).render_rows(batch)[0][3]["color"]
+    four = Renderer(SIZE, outputs=("color",), msaa=4).render_rows(batch)[0][3]["color"]
+    assert (one[..., :3] > 0).any(), "the quad is in view"
+    assert (one != four).any()
