@@ -159,8 +159,10 @@ class Scene:
         outputs: Optional[Sequence[OutputName]] = None,
         backend: Backend = "cpu",
         threads: Optional[int] = None,
+        msaa: int = 1,
     ) -> Dict[str, np.ndarray]:
-        """Renders one view (GIL released). Outputs (default color, depth, normals, ids):
+        """Renders one view (GIL released); `msaa` = samples per pixel of colour (1, 4 or 8;
+        depth, normals and ids stay per pixel). Outputs (default color, depth, normals, ids):
         color uint8 (H, W, 4) sRGB; color_linear float32 (H, W, 4); depth float32 (H, W)
         distance along the view axis, inf = background; ray_depth float32 (H, W) distance from
         the camera centre; normals float32 (H, W, 3) world space,
@@ -172,5 +174,6 @@ class Scene:
         outputs: Optional[Sequence[OutputName]] = None,
         backend: Backend = "cpu",
         threads: Optional[int] = None,
+        msaa: int = 1,
     ) -> List[Dict[str, np.ndarray]]:
         """`render` for every camera, the GIL released for the whole batch."""

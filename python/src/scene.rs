@@ -6,6 +6,7 @@ use std::sync::{Arc, Mutex, PoisonError};
 use kantele::backend::Backend;
 use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::error::RenderError;
+use kantele::multisample::SampleCount;
 use kantele::scene::Scene;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -111,6 +112,14 @@ fn parse_size(size: Option<(i64, i64)>, default: (u32, u32), source: &str) -> Py
     Ok((w as u32, h as u32))
 }
 
+/// Samples per pixel of colour frames: 1, 4 or 8 (what `--msaa` accepts).
+fn parse_msaa(msaa: i64) -> PyResult<SampleCount> {
+    u32::try_from(msaa)
+        .map_err(|_| format!("unsupported sample count {msaa} (expected 1, 4 or 8)"))
+        .and_then(SampleCount::from_count)
+        .map_err(|e| value_error(format!("msaa: {e}")))
+}
+
 fn parse_threads(threads: Option<i64>) -> PyResult<Option<usize>> {
     match threads {
         None => Ok(None),
@@ -128,6 +137,7 @@ impl PyScene {
         outputs: &[OutputKind],
         backend: BackendKind,
         threads: Option<usize>,
+        samples: SampleCount,
     ) -> PyResult<Vec<RenderedView>> {
         let scene = &self.scene;
         let cpu = &self.cpu;
@@ -146,11 +156,13 @@ impl PyScene {
                         *cached = Some(CachedCpu { threads, backend });
                     }
                     let cached = cached.as_mut().expect("a backend was made above");
+                    cached.backend.set_samples(samples)?;
                     render_views(&mut cached.backend, scene, &views, outputs)
                 }
                 BackendKind::Gl => {
                     // The GL backend lives and dies on this thread (it is !Send).
                     let mut gl = kantele_gl::GlBackend::new()?;
+                    gl.set_samples(samples)?;
                     gl.load(scene.clone())?;
                     render_views(&mut gl, scene, &views, outputs)
                 }
@@ -367,9 +379,13 @@ impl PyScene {
     ///   + 1) and primitive (index into `Scene.primitives` + 1) ids, 0 = background; the
     ///   channel names are `kantele.ID_CHANNELS`.
     ///
-    /// `camera=None` uses the scene's camera, `size=None` the scene's resolution. The GIL is
-    /// released while rendering.
-    #[pyo3(signature = (camera = None, size = None, outputs = None, backend = "cpu", threads = None))]
+    /// `camera=None` uses the scene's camera, `size=None` the scene's resolution. `msaa` is the
+    /// samples per pixel of the colour outputs (1, 4 or 8, as `kantele render --msaa`; the GL
+    /// backend offers what its driver does, llvmpipe 4): edges are antialiased, while depth,
+    /// normals and ids stay per pixel, equal to a 1× render's. The GIL is released while
+    /// rendering.
+    #[pyo3(signature = (camera = None, size = None, outputs = None, backend = "cpu", threads = None, msaa = 1))]
+    #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
         py: Python<'py>,
@@ -378,15 +394,18 @@ impl PyScene {
         outputs: Option<Bound<'py, PyAny>>,
         backend: &str,
         threads: Option<i64>,
+        msaa: i64,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let mut all = self.render_many_impl(py, vec![camera], size, outputs, backend, threads)?;
+        let mut all =
+            self.render_many_impl(py, vec![camera], size, outputs, backend, threads, msaa)?;
         view_dict(py, all.remove(0))
     }
 
     /// Renders every camera of `cameras` (a `None` entry is the scene's camera) and returns a
     /// list of dicts as [`render`] does. The scene is prepared once; the GIL is released for
     /// the whole batch.
-    #[pyo3(signature = (cameras, size = None, outputs = None, backend = "cpu", threads = None))]
+    #[pyo3(signature = (cameras, size = None, outputs = None, backend = "cpu", threads = None, msaa = 1))]
+    #[allow(clippy::too_many_arguments)]
     fn render_many<'py>(
         &self,
         py: Python<'py>,
@@ -395,8 +414,9 @@ impl PyScene {
         outputs: Option<Bound<'py, PyAny>>,
         backend: &str,
         threads: Option<i64>,
+        msaa: i64,
     ) -> PyResult<Bound<'py, PyList>> {
-        let all = self.render_many_impl(py, cameras, size, outputs, backend, threads)?;
+        let all = self.render_many_impl(py, cameras, size, outputs, backend, threads, msaa)?;
         let list = PyList::empty(py);
         for view in all {
             list.append(view_dict(py, view)?)?;
@@ -417,6 +437,7 @@ impl PyScene {
 }
 
 impl PyScene {
+    #[allow(clippy::too_many_arguments)]
     fn render_many_impl<'py>(
         &self,
         py: Python<'py>,
@@ -425,6 +446,7 @@ impl PyScene {
         outputs: Option<Bound<'py, PyAny>>,
         backend: &str,
         threads: Option<i64>,
+        msaa: i64,
     ) -> PyResult<Vec<RenderedView>> {
         let outputs = match outputs {
             Some(o) => parse_outputs(&o)?,
@@ -437,7 +459,8 @@ impl PyScene {
         };
         let backend = parse_backend(backend)?;
         let threads = parse_threads(threads)?;
+        let samples = parse_msaa(msaa)?;
         let views = self.views(&cameras, size)?;
-        self.render_frames(py, views, &outputs, backend, threads)
+        self.render_frames(py, views, &outputs, backend, threads, samples)
     }
 }

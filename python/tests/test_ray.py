@@ -1,5 +1,5 @@
 """`kantele.ray` on a local 2-worker Ray: the command line's files and manifest equal
-single-process renders of the same views."""
+single-process renders of the same views (at 4x multisampling, passed through to every worker)."""
 
 import json
 import os
@@ -37,11 +37,11 @@ def test_command_line_on_two_workers_equals_single_process_renders(tmp_path):
     run = subprocess.run(
         [sys.executable, "-m", "kantele.ray", str(scene_dir), "--views", "3",
          "--size", f"{SIZE[0]}x{SIZE[1]}", "--out", str(out), "--workers", "2",
-         "--outputs", "color,depth,ids"],
+         "--outputs", "color,depth,ids", "--msaa", "4"],
         capture_output=True, text=True, timeout=300)
     assert run.returncode == 0, run.stderr[-3000:]
     manifest = json.loads((out / "manifest.json").read_text())
-    assert manifest["workers"] == 2 and manifest["size"] == list(SIZE)
+    assert manifest["workers"] == 2 and manifest["size"] == list(SIZE) and manifest["msaa"] == 4
     renders = manifest["renders"]
     assert len(renders) == 6
     assert {(r["stem"], r["view"]) for r in renders} == {
@@ -49,7 +49,7 @@ def test_command_line_on_two_workers_equals_single_process_renders(tmp_path):
     for r in renders:
         scene = kantele.load(r["scene"])
         cam = scene.orbit_cameras(3, size=SIZE)[r["view"]]
-        expected = scene.render(camera=cam, size=SIZE, outputs=("color", "depth", "ids"))
+        expected = scene.render(camera=cam, size=SIZE, outputs=("color", "depth", "ids"), msaa=4)
         files = r["files"]
         assert files["color"] == f"{r['stem']}_{r['view']:03d}.png"
         np.testing.assert_array_equal(read_png(out / files["color"]), expected["color"])

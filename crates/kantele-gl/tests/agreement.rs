@@ -3,13 +3,16 @@
 //! Both render the same `Scene` by the same rules into float targets; the pictures are compared
 //! as 8-bit sRGB. Skips (with a message) when EGL/OpenGL or the scenes are unavailable.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
-use kantele::compare::{compare, edge_mask, Comparison};
+use kantele_io::compare::{compare, edge_mask, Comparison};
 
 mod common;
 
-use common::{gl_or_skip, render_both};
+use common::{
+    gl_or_skip, interior_allowance, is_textured_scene, print_comparison, reference_scene_files,
+    render_both, INTERIOR_BOUND,
+};
 
 #[test]
 fn builtin_scenes_agree_with_opengl() {
@@ -63,9 +66,6 @@ fn mirrored_draws_agree_with_opengl() {
     assert!(c.mean_color_diff < 0.5, "mean colour {}", c.mean_color_diff);
 }
 
-/// Largest colour difference (8-bit) allowed away from triangle edges.
-const INTERIOR_BOUND: u8 = 3;
-
 #[test]
 fn every_reference_scene_agrees_with_opengl() {
     let Some(dir) = kantele_testkit::shared_dir("scenes") else {
@@ -74,34 +74,15 @@ fn every_reference_scene_agrees_with_opengl() {
     let Some(mut gl) = gl_or_skip() else {
         return;
     };
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("read scenes")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "glb"))
-        .collect();
-    paths.sort();
-    assert!(!paths.is_empty());
     let mut failures = Vec::new();
-    for path in &paths {
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
+    for (name, path) in &reference_scene_files(&dir) {
         let scene = kantele_io::load_scene(path).expect("load").scene;
         let (cpu, gl_image, ids) = render_both(scene, &mut gl);
         let edges = edge_mask(&ids);
         let c: Comparison =
             compare(&cpu, &gl_image, Some(&edges), INTERIOR_BOUND).expect("same size");
-        let textured = name.contains("textured") || name == "near-clip";
-        eprintln!(
-            "{name:28} coverage {:.4}%  mean {:.3}  max {:3}  interior>{INTERIOR_BOUND}: {:6} ({:.3}%)  depth max {:.2e}",
-            100.0 * c.coverage_mismatch_fraction(),
-            c.mean_color_diff,
-            c.max_color_diff,
-            c.interior_over_bound,
-            100.0 * c.interior_over_bound as f64 / c.pixels as f64,
-            c.max_depth_diff,
-        );
+        let textured = is_textured_scene(name);
+        print_comparison("", name, &c);
         // Coverage: edges (almost) exactly through pixel centres are the only expected
         // differences. Investigated on thesis-t2-cubes (2 of 910 000 pixels): a vertex whose
         // window coordinate × 256 lies 0.005 from a rounding boundary, below one f32 ulp there;
@@ -115,14 +96,8 @@ fn every_reference_scene_agrees_with_opengl() {
         if c.mean_color_diff >= 1.0 {
             problems.push("mean colour");
         }
-        // Texture level-of-detail choices differ between drivers (the scenes' README measures
-        // up to 0.6% of pixels between llvmpipe and NVIDIA); untextured scenes must agree
-        // everywhere but on edges.
-        let allowed = if textured {
-            c.pixels / 100
-        } else {
-            c.pixels / 2000
-        };
+        // Texture level-of-detail choices differ between drivers: see `interior_allowance`.
+        let allowed = interior_allowance(c.pixels, textured);
         if c.interior_over_bound > allowed {
             problems.push("interior colour");
         }

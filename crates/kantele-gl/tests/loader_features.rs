@@ -7,10 +7,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3, Vec4};
-use kantele::compare::{compare, edge_mask};
 use kantele::scene::{AlphaMode, Camera, Draw, Material, Mesh, Scene, TextureBinding};
 use kantele::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
 use kantele_gl::GlBackend;
+use kantele_io::compare::{compare, edge_mask};
 
 mod common;
 

@@ -3,44 +3,19 @@
 //! antialiased by both, and a count the driver lacks is refused with a clear error.
 //! Skips (with a message) when EGL/OpenGL or the scenes are unavailable.
 
-use std::path::PathBuf;
 use std::sync::Arc;
 
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
-use kantele::compare::{compare, edge_mask, Comparison};
-use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::multisample::SampleCount;
-use kantele::scene::Scene;
 use kantele::RenderError;
+use kantele_io::compare::{compare, edge_mask, Comparison};
 
 mod common;
 
-use common::{gl_or_skip, render};
-
-/// The scene at `samples` with both backends: (cpu, gl, cpu ids at 1×).
-fn render_both_at(
-    scene: Scene,
-    gl: &mut kantele_gl::GlBackend,
-    samples: SampleCount,
-) -> (FrameImage, FrameImage, FrameImage) {
-    let scene = Arc::new(scene);
-    let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu");
-    cpu.set_samples(samples).expect("cpu samples");
-    gl.set_samples(samples).expect("gl samples");
-    cpu.load(scene.clone()).expect("cpu load");
-    gl.load(scene.clone()).expect("gl load");
-    let view = FrameView::of_scene(&scene);
-    let a = render(&mut cpu, &view);
-    let b = render(gl, &view);
-    let ids = render(
-        &mut cpu,
-        &FrameView {
-            pass: Pass::Ids,
-            ..view
-        },
-    );
-    (a, b, ids)
-}
+use common::{
+    gl_or_skip, interior_allowance, is_textured_scene, print_comparison, reference_scene_files,
+    render, render_both_at, INTERIOR_BOUND,
+};
 
 /// Pixels with a value strictly between two others in 8-bit sRGB: partly covered edges.
 fn partial_pixels(image: &FrameImage) -> usize {
@@ -55,23 +30,13 @@ fn partial_pixels(image: &FrameImage) -> usize {
         .count()
 }
 
-/// Largest colour difference (8-bit) allowed away from triangle edges (as at 1×).
-const INTERIOR_BOUND: u8 = 3;
 /// Mean colour difference (8-bit, over every pixel) allowed at 4×.
 const MEAN_BOUND: f64 = 1.0;
 
 fn check(name: &str, cpu: &FrameImage, gl: &FrameImage, ids: &FrameImage, textured: bool) {
     let edges = edge_mask(ids);
     let c: Comparison = compare(cpu, gl, Some(&edges), INTERIOR_BOUND).expect("same size");
-    eprintln!(
-        "4x {name:28} coverage {:.4}%  mean {:.3}  max {:3}  interior>{INTERIOR_BOUND}: {:6} ({:.3}%)  depth max {:.2e}",
-        100.0 * c.coverage_mismatch_fraction(),
-        c.mean_color_diff,
-        c.max_color_diff,
-        c.interior_over_bound,
-        100.0 * c.interior_over_bound as f64 / c.pixels as f64,
-        c.max_depth_diff,
-    );
+    print_comparison("4x ", name, &c);
     // Depth is per pixel in both (the 1× rule), so coverage agrees as at 1×.
     assert!(c.coverage_mismatch_fraction() <= 0.001, "{name}: coverage");
     assert!(
@@ -79,11 +44,7 @@ fn check(name: &str, cpu: &FrameImage, gl: &FrameImage, ids: &FrameImage, textur
         "{name}: mean colour {}",
         c.mean_color_diff
     );
-    let allowed = if textured {
-        c.pixels / 100
-    } else {
-        c.pixels / 2000
-    };
+    let allowed = interior_allowance(c.pixels, textured);
     assert!(
         c.interior_over_bound <= allowed,
         "{name}: {} interior pixels over {INTERIOR_BOUND}",
@@ -135,22 +96,11 @@ fn every_reference_scene_agrees_with_opengl_at_4x() {
     let Some(mut gl) = gl_or_skip() else {
         return;
     };
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .expect("read scenes")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "glb"))
-        .collect();
-    paths.sort();
-    assert!(!paths.is_empty());
-    for path in &paths {
-        let name = path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default();
+    for (name, path) in &reference_scene_files(&dir) {
         let scene = kantele_io::load_scene(path).expect("load").scene;
         let (cpu, gl_image, ids) = render_both_at(scene, &mut gl, SampleCount::X4);
-        let textured = name.contains("textured") || name == "near-clip";
-        check(&name, &cpu, &gl_image, &ids, textured);
+        let textured = is_textured_scene(name);
+        check(name, &cpu, &gl_image, &ids, textured);
     }
 }
 

@@ -15,7 +15,9 @@
 //!   [`Backend`](kantele::backend::Backend), and a [`SceneInfo`] with facts and warnings about
 //!   the source.
 //! - [`mesh_util`] holds helpers shared by the loaders (flat normals, strips and fans to lists,
-//!   a framing camera).
+//!   a framing camera); [`texture_util`] the procedural textures of the built-in scenes.
+//! - [`compare`] measures how two renderings of one frame differ (coverage, colour, depth, a
+//!   difference image): `kantele compare` and the OpenGL agreement tests use it.
 //!
 //! ```no_run
 //! use std::sync::Arc;
@@ -40,6 +42,7 @@ use thiserror::Error;
 mod accessor;
 mod budget;
 mod builtin;
+pub mod compare;
 mod ear_clip;
 /// Bodies of the fuzz targets in `fuzz/`, callable from stable tests (not a public API).
 #[doc(hidden)]
@@ -56,7 +59,7 @@ pub mod pose;
 mod quiet_panic;
 mod read_policy;
 pub mod row_writer;
-mod texture_util;
+pub mod texture_util;
 mod uri;
 
 pub use mesh_util::flat_normals;

@@ -114,16 +114,23 @@ pub fn trilinear_repeat() -> Sampler {
 }
 
 /// A `size` × `size` sRGB checkerboard of `squares` × `squares` squares in two colours (8-bit
-/// sRGB RGB), the top-left square in `a` ([`kantele::demo::checker_texture`] for sizes that
-/// cannot fail).
+/// sRGB RGB), the top-left square in `a`. `size` is clamped to `1..=MAX_TEXTURE_SIZE`.
 pub fn checker(size: u32, squares: u32, a: [u8; 3], b: [u8; 3]) -> Texture {
-    kantele::demo::checker_texture(
-        size.clamp(1, kantele::shade::texture::MAX_TEXTURE_SIZE),
-        squares,
-        a,
-        b,
-    )
-    .expect("a clamped checker size is always valid")
+    let size = size.clamp(1, kantele::shade::texture::MAX_TEXTURE_SIZE);
+    let cell = (size / squares.max(1)).max(1);
+    let mut rgba = Vec::with_capacity(size as usize * size as usize * 4);
+    for y in 0..size {
+        for x in 0..size {
+            let c = if ((x / cell) + (y / cell)) % 2 == 0 {
+                a
+            } else {
+                b
+            };
+            rgba.extend_from_slice(&[c[0], c[1], c[2], 255]);
+        }
+    }
+    Texture::from_rgba8(size, size, &rgba, ColorSpace::Srgb)
+        .expect("a clamped checker size is always valid")
 }
 
 #[cfg(test)]

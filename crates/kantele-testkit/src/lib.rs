@@ -4,8 +4,13 @@
 //! skips — unless the environment variable `KANTELE_REQUIRE` (a comma-separated list such as
 //! `gl,display,scenes`) names what it lacks: then it fails, so a CI machine that is meant to have
 //! the thing can never pass by skipping. `.ci/run` sets `KANTELE_REQUIRE` for what CI installs.
+//!
+//! [`demo`] holds the seed documents' two scenes written against the pipeline API, which the
+//! core's reference-image and band tests and its `seeds` example render.
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
+
+pub mod demo;
 
 use std::fmt::Display;
 use std::path::{Path, PathBuf};

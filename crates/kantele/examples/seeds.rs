@@ -10,9 +10,9 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     for (name, render) in [
         (
             "thesis-cube",
-            kantele::demo::render_thesis_cube as fn(&mut Renderer) -> _,
+            kantele_testkit::demo::render_thesis_cube as fn(&mut Renderer) -> _,
         ),
-        ("exercise", kantele::demo::render_exercise),
+        ("exercise", kantele_testkit::demo::render_exercise),
     ] {
         let stats = render(&mut renderer)?;
         let fb = renderer.framebuffer();

@@ -46,7 +46,8 @@
 //! # Ok::<(), kantele::RenderError>(())
 //! ```
 //!
-//! [`demo`] draws two complete scenes (a textured cube, a lit and blended scene) the same way.
+//! `kantele_testkit::demo` draws two complete scenes (a textured cube, a lit and blended scene)
+//! the same way.
 //!
 //! # Conventions
 //!
@@ -89,10 +90,8 @@
 //! - [`material`] — the built-in material shader implementing the reference-scene rules.
 //! - [`backend`] — the [`Backend`](backend::Backend) trait shared by CPU and OpenGL.
 //! - [`cpu`] — the CPU backend: scenes through the pipeline with the built-in materials.
-//! - [`compare`] — picture agreement between two backends' frames.
 //! - [`camera`] — view and projection matrices (OpenGL conventions).
 //! - [`color`] — the sRGB transfer curves and 8-bit quantisation.
-//! - [`demo`] — two small scenes written against the pipeline API.
 //! - [`error`] — [`RenderError`].
 //! - `fault` — planted bugs for testing the test tools (only with the `fault-injection`
 //!   feature, switched on by `KANTELE_FAULT`).
@@ -106,9 +105,7 @@ pub mod backend;
 pub mod band;
 pub mod camera;
 pub mod color;
-pub mod compare;
 pub mod cpu;
-pub mod demo;
 pub mod error;
 #[cfg(feature = "fault-injection")]
 pub mod fault;

@@ -1,11 +1,11 @@
 //! Render regions (bands): a picture rendered band by band equals the unbanded picture bit for
 //! bit, and a band allocates only its own tiles.
 
-use kantele::demo::{render_exercise, render_thesis_cube};
 use kantele::pipeline::{Renderer, RendererOptions};
 use kantele::raster::Strategy;
 use kantele::stats::FrameStats;
 use kantele::RenderError;
+use kantele_testkit::demo::{render_exercise, render_thesis_cube};
 
 type Demo = fn(&mut Renderer) -> Result<FrameStats, RenderError>;
 

@@ -4,57 +4,30 @@
 
 use std::sync::Arc;
 
-use glam::{Mat4, Vec2, Vec3, Vec4};
+use glam::{Mat4, Vec2, Vec3};
 use kantele::backend::{Backend, FrameView, Pass};
 use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::multisample::SampleCount;
-use kantele::pipeline::{FnShader, Fragment, Indices, RenderState, Renderer, RendererOptions};
+use kantele::pipeline::{Renderer, RendererOptions};
 use kantele::raster::Strategy;
-use kantele::rop::{BlendMode, DepthFunc};
 use kantele::scene::{Camera, Draw, Material, Mesh, Scene};
-use kantele::setup::CullMode;
 use kantele::simd::Isa;
 use kantele::RenderError;
 
-fn flat_shader() -> impl kantele::pipeline::Shader<Vertex = Vec2> {
-    FnShader::new(
-        0,
-        |p: &Vec2, _: &mut [f32]| Vec4::new(p.x, p.y, 0.0, 1.0),
-        |_: &Fragment<'_>| Some(Vec4::new(1.0, 1.0, 1.0, 1.0)),
-    )
-}
+mod common;
 
-fn counting_state() -> RenderState {
-    RenderState {
-        cull: CullMode::None,
-        depth_test: false,
-        depth_write: false,
-        depth_func: DepthFunc::Always,
-        blend: BlendMode::Additive,
-        sort_back_to_front: false,
-        ..RenderState::default()
-    }
-}
+use common::{busy_frame, jittered_grid, red_channel};
 
-/// Red channel of `vertices` drawn with additive white at `samples` per pixel.
+/// The size of the busy frame.
+const SIZE: (u32, u32) = (181, 133);
+
+/// Red channel of `vertices` drawn with the counting shader at `samples` per pixel.
 fn red(size: (u32, u32), vertices: &[Vec2], indices: &[u32], samples: SampleCount) -> Vec<f32> {
     let options = RendererOptions {
         samples,
         ..RendererOptions::default()
     };
-    let mut renderer = Renderer::new(size.0, size.1, options).expect("renderer");
-    let shader = flat_shader();
-    let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
-    frame
-        .draw(&shader, vertices, Indices::U32(indices), counting_state())
-        .expect("draw");
-    frame.end();
-    renderer
-        .framebuffer()
-        .read_color()
-        .iter()
-        .map(|c| c[0])
-        .collect()
+    red_channel(size, vertices, indices, options)
 }
 
 #[test]
@@ -84,41 +57,6 @@ fn a_triangle_edge_gets_intermediate_values_only_when_multisampled() {
     }
 }
 
-/// A jittered grid of `n × n` cells over the square [lo, hi]², split along random diagonals.
-fn jittered_grid(n: usize, lo: f32, hi: f32, seed: u64) -> (Vec<Vec2>, Vec<u32>) {
-    let mut state = seed | 1;
-    let mut rand = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state % 1_000_000) as f32 / 1_000_000.0
-    };
-    let cell = (hi - lo) / n as f32;
-    let mut vertices = Vec::new();
-    for j in 0..=n {
-        for i in 0..=n {
-            let mut p = Vec2::new(lo + i as f32 * cell, lo + j as f32 * cell);
-            if i > 0 && i < n && j > 0 && j < n {
-                p += (Vec2::new(rand(), rand()) - 0.5) * cell * 0.3;
-            }
-            vertices.push(p);
-        }
-    }
-    let mut indices = Vec::new();
-    let at = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    for j in 0..n {
-        for i in 0..n {
-            let (a, b, c, d) = (at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1));
-            if rand() < 0.5 {
-                indices.extend([a, b, c, a, c, d]);
-            } else {
-                indices.extend([a, b, d, b, c, d]);
-            }
-        }
-    }
-    (vertices, indices)
-}
-
 #[test]
 fn shared_edges_cover_every_sample_exactly_once() {
     // The square's sides lie on pixel boundaries (NDC ±0.5 on 96 × 80 = pixels 24/72, 20/60),
@@ -143,64 +81,6 @@ fn shared_edges_cover_every_sample_exactly_once() {
     }
 }
 
-/// 300 opaque then 300 alpha-blended random triangles, depth-tested.
-fn busy_frame(options: RendererOptions) -> (Vec<[f32; 4]>, Vec<f32>) {
-    let mut seed = 99u64;
-    let mut rand = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed % 1_000_000) as f32 / 1_000_000.0
-    };
-    let vertices: Vec<[f32; 7]> = (0..600)
-        .map(|_| {
-            [
-                rand() * 3.0 - 1.5,
-                rand() * 3.0 - 1.5,
-                rand() * 2.0 - 1.0,
-                rand(),
-                rand(),
-                rand(),
-                rand(),
-            ]
-        })
-        .collect();
-    let indices: Vec<u32> = (0..600).collect();
-    let shader = FnShader::new(
-        4,
-        |v: &[f32; 7], out: &mut [f32]| {
-            out.copy_from_slice(&v[3..7]);
-            Vec4::new(v[0], v[1], v[2], 1.0 + v[2] * 0.3)
-        },
-        |f: &Fragment<'_>| {
-            let v = f.varyings();
-            Some(Vec4::new(v[0], v[1], v[2], v[3]))
-        },
-    );
-    let mut renderer = Renderer::new(181, 133, options).expect("renderer");
-    let mut frame = renderer.begin_frame(Some(Vec4::new(0.1, 0.2, 0.3, 1.0)), Some(1.0));
-    let opaque = RenderState {
-        cull: CullMode::None,
-        ..RenderState::default()
-    };
-    let blended = RenderState {
-        blend: BlendMode::Alpha,
-        depth_write: false,
-        ..opaque
-    };
-    frame
-        .draw(&shader, &vertices, Indices::U32(&indices[..300]), opaque)
-        .expect("draw");
-    frame
-        .draw(&shader, &vertices, Indices::U32(&indices[300..]), blended)
-        .expect("draw");
-    frame.end();
-    (
-        renderer.framebuffer().read_color(),
-        renderer.framebuffer().read_depth(),
-    )
-}
-
 #[test]
 fn multisampled_pictures_are_identical_for_every_isa_strategy_and_thread_count() {
     let options = |threads: usize, strategy: Strategy, isa: Isa| RendererOptions {
@@ -210,17 +90,20 @@ fn multisampled_pictures_are_identical_for_every_isa_strategy_and_thread_count()
         samples: SampleCount::X4,
         ..RendererOptions::default()
     };
-    let reference = busy_frame(options(1, Strategy::BoundingBox, Isa::Scalar));
-    let single = busy_frame(RendererOptions {
-        samples: SampleCount::X1,
-        ..options(1, Strategy::BoundingBox, Isa::Scalar)
-    });
+    let reference = busy_frame(SIZE, options(1, Strategy::BoundingBox, Isa::Scalar));
+    let single = busy_frame(
+        SIZE,
+        RendererOptions {
+            samples: SampleCount::X1,
+            ..options(1, Strategy::BoundingBox, Isa::Scalar)
+        },
+    );
     assert!(reference.0 != single.0, "4x must change the picture");
     let isas: Vec<Isa> = Isa::ALL.into_iter().filter(|i| i.is_supported()).collect();
     for isa in isas {
         for threads in [1, 3] {
             for strategy in Strategy::ALL {
-                let image = busy_frame(options(threads, strategy, isa));
+                let image = busy_frame(SIZE, options(threads, strategy, isa));
                 assert!(
                     image == reference,
                     "4x: {strategy} with {threads} threads on {isa} differs"
@@ -230,10 +113,13 @@ fn multisampled_pictures_are_identical_for_every_isa_strategy_and_thread_count()
     }
     // 8× once per instruction set.
     let eight = |isa: Isa| {
-        busy_frame(RendererOptions {
-            samples: SampleCount::X8,
-            ..options(2, Strategy::Bisector, isa)
-        })
+        busy_frame(
+            SIZE,
+            RendererOptions {
+                samples: SampleCount::X8,
+                ..options(2, Strategy::Bisector, isa)
+            },
+        )
     };
     let eight_reference = eight(Isa::Scalar);
     for isa in Isa::ALL.into_iter().filter(|i| i.is_supported()) {
@@ -243,14 +129,17 @@ fn multisampled_pictures_are_identical_for_every_isa_strategy_and_thread_count()
 
 #[test]
 fn multisampled_depth_equals_the_single_sample_depth() {
-    let (_, depth_1x) = busy_frame(RendererOptions::default());
+    let (_, depth_1x) = busy_frame(SIZE, RendererOptions::default());
     let covered = depth_1x.iter().filter(|d| **d < 1.0).count();
     assert!(covered > 5_000, "{covered}");
     for samples in [SampleCount::X4, SampleCount::X8] {
-        let (_, depth) = busy_frame(RendererOptions {
-            samples,
-            ..RendererOptions::default()
-        });
+        let (_, depth) = busy_frame(
+            SIZE,
+            RendererOptions {
+                samples,
+                ..RendererOptions::default()
+            },
+        );
         let same = depth
             .iter()
             .zip(&depth_1x)

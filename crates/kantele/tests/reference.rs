@@ -1,4 +1,4 @@
-//! Reference images of the seed documents' scenes (see `kantele::demo`).
+//! Reference images of the seed documents' scenes (see `kantele_testkit::demo`).
 //!
 //! A missing or different reference fails; `KANTELE_BLESS=1 cargo test -p kantele --test
 //! reference` rewrites them. On failure the actual image and a difference image are written to
@@ -94,10 +94,10 @@ fn check(name: &str, render: fn(&mut Renderer) -> Result<FrameStats, RenderError
 
 #[test]
 fn thesis_textured_cube_matches_its_reference() {
-    check("thesis-cube", kantele::demo::render_thesis_cube);
+    check("thesis-cube", kantele_testkit::demo::render_thesis_cube);
 }
 
 #[test]
 fn exercise_blended_scene_matches_its_reference() {
-    check("exercise", kantele::demo::render_exercise);
+    check("exercise", kantele_testkit::demo::render_exercise);
 }

@@ -103,8 +103,9 @@ def peak_rss_mb() -> float:
 
 class Renderer:
     """A ``map_batches`` callable class (a Ray actor): loads each scene once, renders the views
-    of a batch with ``Scene.render_many`` and returns their arrays as columns, or, with
-    ``out_dir``, writes them as files and returns their names."""
+    of a batch with ``Scene.render_many`` (``msaa`` samples per pixel of colour: 1, 4 or 8) and
+    returns their arrays as columns, or, with ``out_dir``, writes them as files and returns
+    their names."""
 
     def __init__(
         self,
@@ -112,11 +113,13 @@ class Renderer:
         outputs: Sequence[str] = ("color", "depth", "ids"),
         out_dir: Optional[str] = None,
         threads: Optional[int] = None,
+        msaa: int = 1,
     ):
         self.size = (int(size[0]), int(size[1]))
         self.outputs = tuple(outputs)
         self.out_dir = out_dir
         self.threads = threads
+        self.msaa = msaa
         self.scenes: Dict[str, kantele.Scene] = {}
 
     def scene(self, path: str) -> "kantele.Scene":
@@ -139,7 +142,8 @@ class Renderer:
                 scene = self.scene(path)
                 cameras = scene.orbit_cameras(views, size=self.size)
                 chosen = [cameras[int(batch["view"][i])] for i in indices]
-                images = scene.render_many(chosen, outputs=self.outputs, threads=self.threads)
+                images = scene.render_many(chosen, outputs=self.outputs, threads=self.threads,
+                                           msaa=self.msaa)
             except (OSError, ValueError) as e:
                 if self.out_dir is None:
                     raise
@@ -193,9 +197,11 @@ def render_files(
     workers: int,
     outputs: Sequence[str] = ("color", "depth", "ids"),
     batch_size: int = 4,
+    msaa: int = 1,
 ) -> Dict[str, Any]:
     """Renders ``views`` orbit views of every scene on ``workers`` Ray actors (one CPU each) into
-    ``out_dir`` and writes ``out_dir/manifest.json``; returns the manifest. Scenes that cannot
+    ``out_dir`` (``msaa`` samples per pixel of colour) and writes ``out_dir/manifest.json``;
+    returns the manifest. Scenes that cannot
     be loaded or rendered are left out and listed (one message each) under ``errors``. Uses the running Ray
     (``ray.init(address=...)`` first for a cluster) or starts a local one with ``workers``
     CPUs."""
@@ -206,6 +212,8 @@ def render_files(
             raise ValueError(f"unknown output '{o}' (choose from: {', '.join(kantele.OUTPUTS)})")
     if workers < 1:
         raise ValueError(f"workers {workers} must be at least 1")
+    if msaa not in (1, 4, 8):
+        raise ValueError(f"msaa: unsupported sample count {msaa} (expected 1, 4 or 8)")
     os.makedirs(out_dir, exist_ok=True)
     out_abs = os.path.abspath(out_dir)
     if not ray.is_initialized():
@@ -215,7 +223,7 @@ def render_files(
     ds = dataset(scenes, views).map_batches(
         Renderer,
         fn_constructor_kwargs={"size": size, "outputs": tuple(outputs), "out_dir": out_abs,
-                               "threads": 1},
+                               "threads": 1, "msaa": msaa},
         batch_size=batch_size,
         concurrency=workers,
         num_cpus=1,
@@ -228,6 +236,7 @@ def render_files(
         "size": [int(size[0]), int(size[1])],
         "views": views,
         "outputs": list(outputs),
+        "msaa": msaa,
         "workers": workers,
         "elapsed_s": elapsed,
         "frames_per_s": len(records) / elapsed if elapsed > 0 else None,

@@ -1,5 +1,5 @@
 """``python -m kantele.ray SCENE_OR_DIR... --views K --size WxH --out DIR --workers N
-[--outputs color,depth,ids] [--address ADDR]``: orbit renders of every scene on a Ray cluster
+[--outputs color,depth,ids] [--msaa 1|4|8] [--address ADDR]``: orbit renders of every scene on a Ray cluster
 (a local one with N workers unless ``--address`` names a running cluster)."""
 
 from __future__ import annotations
@@ -34,6 +34,8 @@ def main(argv: Optional[List[str]] = None) -> int:
     parser.add_argument("--workers", type=int, default=1, help="Ray actors, one CPU each")
     parser.add_argument("--outputs", default="color,depth,ids",
                         help="comma-separated: color, color_linear, depth, normals, ids")
+    parser.add_argument("--msaa", type=int, choices=(1, 4, 8), default=1,
+                        help="samples per pixel of colour (default 1)")
     parser.add_argument("--address", default=None,
                         help="a running Ray cluster (ray.init(address=...)); default: a local one")
     parser.add_argument("--batch-size", type=int, default=4)
@@ -57,7 +59,7 @@ def main(argv: Optional[List[str]] = None) -> int:
         if args.address:
             ray.init(address=args.address, log_to_driver=False, logging_level=logging.ERROR)
         manifest = render_files(scenes, args.views, args.size, args.out, args.workers,
-                                outputs, args.batch_size)
+                                outputs, args.batch_size, args.msaa)
     except (OSError, ValueError) as e:
         print(f"kantele.ray: {e}", file=sys.stderr)
         return 1

@@ -6,7 +6,7 @@
 //! ```
 //! use kantele::pipeline::{Renderer, RendererOptions};
 //! let mut renderer = Renderer::new(320, 240, RendererOptions::default())?;
-//! let stats = kantele::demo::render_thesis_cube(&mut renderer)?;
+//! let stats = kantele_testkit::demo::render_thesis_cube(&mut renderer)?;
 //! assert!(stats.fragments_shaded > 0);
 //! let rgba8: Vec<u8> = renderer.framebuffer().read_rgba8(true); // sRGB-encoded
 //! assert_eq!(rgba8.len(), 320 * 240 * 4);
@@ -15,35 +15,14 @@
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 
-use crate::camera::{frustum, look_at, normal_matrix, perspective};
-use crate::error::RenderError;
-use crate::pipeline::{FnShader, Fragment, Indices, RenderState, Renderer};
-use crate::rop::BlendMode;
-use crate::setup::CullMode;
-use crate::shade::texture::{ColorSpace, MinFilter, Sampler, Texture, Wrap};
-use crate::stats::FrameStats;
-
-/// A `size × size` sRGB checker texture with `squares × squares` squares of two colours.
-pub fn checker_texture(
-    size: u32,
-    squares: u32,
-    a: [u8; 3],
-    b: [u8; 3],
-) -> Result<Texture, RenderError> {
-    let cell = (size / squares.max(1)).max(1);
-    let mut rgba = Vec::with_capacity((size * size * 4) as usize);
-    for y in 0..size {
-        for x in 0..size {
-            let c = if ((x / cell) + (y / cell)) % 2 == 0 {
-                a
-            } else {
-                b
-            };
-            rgba.extend_from_slice(&[c[0], c[1], c[2], 255]);
-        }
-    }
-    Texture::from_rgba8(size, size, &rgba, ColorSpace::Srgb)
-}
+use kantele::camera::{frustum, look_at, normal_matrix, perspective};
+use kantele::pipeline::{FnShader, Fragment, Indices, RenderState, Renderer};
+use kantele::rop::BlendMode;
+use kantele::setup::CullMode;
+use kantele::shade::texture::{MinFilter, Sampler, Wrap};
+use kantele::stats::FrameStats;
+use kantele::RenderError;
+use kantele_io::texture_util::checker;
 
 /// The thesis' vertex: position, colour and texture coordinate.
 #[derive(Clone, Copy, Debug)]
@@ -113,7 +92,7 @@ pub fn render_thesis_cube(renderer: &mut Renderer) -> Result<FrameStats, RenderE
     let projection = frustum(-0.25 * aspect, 0.25 * aspect, -0.25, 0.25, 0.5, 100.0);
     let view = look_at(Vec3::new(4.4, 0.8, 7.6), Vec3::new(3.0, 0.0, 5.0), Vec3::Y);
     let transform = projection * view * Mat4::from_translation(Vec3::new(3.0, 0.0, 5.0));
-    let texture = checker_texture(256, 8, [230, 230, 230], [40, 90, 160])?;
+    let texture = checker(256, 8, [230, 230, 230], [40, 90, 160]);
     let sampler = Sampler {
         wrap_s: Wrap::Repeat,
         wrap_t: Wrap::Repeat,

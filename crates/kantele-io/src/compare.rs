@@ -1,7 +1,7 @@
 //! Picture agreement between two renderings of the same frame (e.g. Kantele and OpenGL):
 //! coverage, 8-bit colour and depth differences, and a difference image.
 
-use crate::backend::FrameImage;
+use kantele::backend::FrameImage;
 
 /// How two frames differ. Colour differences are in 8-bit sRGB levels over the RGB channels.
 #[derive(Clone, Debug, PartialEq)]
@@ -96,7 +96,7 @@ pub fn compare(
     Some(result)
 }
 
-/// Marks pixels on triangle edges from an id frame ([`crate::backend::Pass::Ids`]): a pixel is
+/// Marks pixels on triangle edges from an id frame ([`kantele::backend::Pass::Ids`]): a pixel is
 /// on an edge when any of its 8 neighbours shows a different triangle (or background).
 pub fn edge_mask(ids: &FrameImage) -> Vec<bool> {
     let (w, h) = (ids.width as i64, ids.height as i64);

@@ -1,0 +1,71 @@
+//! `kantele info` and `kantele bench`.
+
+use crate::common::{kantele, ok, stdout};
+use crate::shared_scenes;
+
+#[test]
+fn info_builtin() {
+    let o = kantele(&["info", "--builtin", "cube"]);
+    ok(&o);
+    assert!(stdout(&o).contains("triangles"));
+    let o = kantele(&["info", "--builtin", "teapot", "--json"]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert!(v["triangles"].as_u64().unwrap() > 100);
+}
+
+#[test]
+fn info_bunny() {
+    let Some(scenes) = shared_scenes() else {
+        return;
+    };
+    let path = scenes.join("bunny.glb");
+    let o = kantele(&["info", path.to_str().unwrap(), "--json"]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert_eq!(v["triangles"], 69451);
+    assert_eq!(v["resolution"], serde_json::json!([1024, 768]));
+    let o = kantele(&[
+        "info",
+        scenes.join("spot-textured.glb").to_str().unwrap(),
+        "--json",
+    ]);
+    ok(&o);
+    let v: serde_json::Value = serde_json::from_str(stdout(&o).trim()).unwrap();
+    assert_eq!(v["textures"][0]["width"], 1024);
+    assert_eq!(v["textures"][0]["levels"], 11);
+}
+
+#[test]
+fn bench_two_frames() {
+    let o = kantele(&[
+        "bench",
+        "--builtin",
+        "cube",
+        "--frames",
+        "2",
+        "--warmup",
+        "1",
+        "--json",
+    ]);
+    ok(&o);
+    let out = stdout(&o);
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 1, "{out}");
+    let v: serde_json::Value = serde_json::from_str(lines[0]).unwrap();
+    assert_eq!(v["backend"], "cpu");
+    assert_eq!(v["frames"], 2);
+    assert!(v["median_ms"].as_f64().unwrap() > 0.0);
+    assert!(v["min_ms"].as_f64().unwrap() <= v["max_ms"].as_f64().unwrap());
+    let o = kantele(&[
+        "bench",
+        "--builtin",
+        "cube",
+        "--frames",
+        "2",
+        "--warmup",
+        "0",
+    ]);
+    ok(&o);
+    assert!(stdout(&o).contains("median"));
+}

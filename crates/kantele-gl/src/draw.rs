@@ -1,0 +1,190 @@
+//! One frame's GL commands: the fixed state, then per draw its culling, alpha mode, blending,
+//! uniforms, textures and primitive mode, in the scene's draw order.
+
+use glam::{Mat3, Mat4, Vec4};
+use glow::HasContext;
+use kantele::backend::{FrameView, Pass};
+use kantele::camera::normal_matrix;
+use kantele::scene::{AlphaMode, Scene, Topology};
+use kantele::stats::FrameStats;
+use kantele::RenderError;
+
+use crate::{shaders, GlBackend};
+
+impl GlBackend {
+    /// Clear + every draw + glFinish into `framebuffer` (the target's or its multisampled
+    /// one), with the context current. `depth_only` clears and draws depth alone (colour
+    /// writes off): the per-pixel depth of a multisampled frame.
+    pub(crate) fn draw_frame(
+        &self,
+        scene: &Scene,
+        view: &FrameView,
+        framebuffer: glow::Framebuffer,
+        depth_only: bool,
+        stats: &mut FrameStats,
+    ) -> Result<(), RenderError> {
+        let gl = &self.gl;
+        let u = &self.uniforms;
+        let color_pass = view.pass == Pass::Color;
+        let pass = match view.pass {
+            Pass::Color => shaders::PASS_COLOR,
+            Pass::Normals => shaders::PASS_NORMALS,
+            Pass::Ids => shaders::PASS_IDS,
+        };
+        let clear = if color_pass {
+            scene.clear_color
+        } else {
+            Vec4::ZERO
+        };
+        // Window row 0 = image row 0: flip y after the projection (see the crate docs).
+        let flip = Mat4::from_diagonal(Vec4::new(1.0, -1.0, 1.0, 1.0));
+        let view_projection = flip * view.projection * view.view;
+        // SAFETY: `gl` is current on this thread (caller); the program, target, meshes, textures
+        // and samplers are ours and alive; every draw's mesh, material and texture index was
+        // checked by `Scene::validate` in `load`, and index buffers only hold in-range indices.
+        unsafe {
+            let target = self.target.as_ref().expect("target was created");
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
+            gl.draw_buffers(&[glow::COLOR_ATTACHMENT0]);
+            gl.viewport(0, 0, target.width as i32, target.height as i32);
+            gl.disable(glow::SCISSOR_TEST);
+            gl.disable(glow::BLEND);
+            gl.enable(glow::MULTISAMPLE);
+            gl.color_mask(!depth_only, !depth_only, !depth_only, !depth_only);
+            gl.depth_mask(true);
+            gl.clear_color(clear.x, clear.y, clear.z, clear.w);
+            gl.clear_depth_f64(1.0);
+            gl.clear(if depth_only {
+                glow::DEPTH_BUFFER_BIT
+            } else {
+                glow::COLOR_BUFFER_BIT | glow::DEPTH_BUFFER_BIT
+            });
+
+            gl.enable(glow::DEPTH_TEST);
+            gl.depth_func(glow::LESS);
+            gl.depth_range_f64(0.0, 1.0);
+            gl.front_face(glow::CW);
+            gl.cull_face(glow::BACK);
+            gl.blend_func_separate(
+                glow::SRC_ALPHA,
+                glow::ONE_MINUS_SRC_ALPHA,
+                glow::ONE,
+                glow::ONE_MINUS_SRC_ALPHA,
+            );
+            gl.blend_equation(glow::FUNC_ADD);
+
+            gl.use_program(Some(self.program));
+            gl.uniform_3_f32_slice(u.to_light.as_ref(), &view.to_light.to_array());
+            gl.uniform_3_f32_slice(u.light_color.as_ref(), &view.light_color.to_array());
+            gl.uniform_1_f32(u.ambient.as_ref(), scene.ambient);
+            gl.uniform_1_i32(u.pass.as_ref(), pass);
+            gl.uniform_1_i32(u.base_color_texture.as_ref(), 0);
+            gl.uniform_1_i32(u.emissive_texture.as_ref(), 1);
+            gl.active_texture(glow::TEXTURE0);
+
+            // Points and lines are drawn with GL's initial point size and line width, 1 (never
+            // changed here; PROGRAM_POINT_SIZE stays off), as the CPU pipeline draws them.
+            gl.line_width(1.0);
+            let unlit = scene.unlit_materials();
+            for draw_index in scene.draw_order(&view.view) {
+                let draw = &scene.draws[draw_index];
+                let mesh = &scene.meshes[draw.mesh];
+                let gpu_mesh = &self.gpu.meshes[draw.mesh];
+                let material = scene.draw_material(draw.mesh, &unlit);
+                stats.draws += 1;
+                stats.triangles_in += mesh.primitive_count() as u64;
+                if gpu_mesh.index_count == 0 {
+                    continue;
+                }
+                // The y-flip mirrors the winding: front (CCW in NDC) is CW in GL's window; a
+                // mirroring model matrix flips it once more.
+                gl.front_face(match draw.front_face() {
+                    kantele::setup::FrontFace::Ccw => glow::CW,
+                    kantele::setup::FrontFace::Cw => glow::CCW,
+                });
+                if material.double_sided {
+                    gl.disable(glow::CULL_FACE);
+                } else {
+                    gl.enable(glow::CULL_FACE);
+                }
+                let (alpha_mode, cutoff) = match material.alpha_mode {
+                    AlphaMode::Opaque => (shaders::ALPHA_OPAQUE, 0.0),
+                    AlphaMode::Mask { cutoff } => (shaders::ALPHA_MASK, cutoff),
+                    AlphaMode::Blend => (shaders::ALPHA_BLEND, 0.0),
+                };
+                let blend = alpha_mode == shaders::ALPHA_BLEND;
+                if blend && color_pass {
+                    gl.enable(glow::BLEND);
+                } else {
+                    gl.disable(glow::BLEND);
+                }
+                gl.depth_mask(!blend);
+
+                let mvp = view_projection * draw.model;
+                let normal: Mat3 = normal_matrix(&draw.model);
+                gl.uniform_matrix_4_f32_slice(
+                    u.model_view_projection.as_ref(),
+                    false,
+                    &mvp.to_cols_array(),
+                );
+                gl.uniform_matrix_3_f32_slice(
+                    u.normal_matrix.as_ref(),
+                    false,
+                    &normal.to_cols_array(),
+                );
+                gl.uniform_4_f32_slice(
+                    u.base_color_factor.as_ref(),
+                    &material.base_color_factor.to_array(),
+                );
+                gl.uniform_1_i32(u.unlit.as_ref(), material.unlit as i32);
+                gl.uniform_1_i32(u.alpha_mode.as_ref(), alpha_mode);
+                gl.uniform_1_f32(u.alpha_cutoff.as_ref(), cutoff);
+                gl.uniform_1_i32(u.double_sided.as_ref(), material.double_sided as i32);
+                gl.uniform_2_f32(
+                    u.ids.as_ref(),
+                    (draw.node_index + 1) as f32,
+                    (draw_index + 1) as f32,
+                );
+                gl.uniform_3_f32_slice(u.emissive.as_ref(), &material.emissive.to_array());
+                gl.active_texture(glow::TEXTURE1);
+                match material.emissive_texture {
+                    Some(binding) => {
+                        gl.uniform_1_i32(u.has_emissive_texture.as_ref(), 1);
+                        gl.bind_texture(glow::TEXTURE_2D, Some(self.gpu.textures[binding.texture]));
+                        gl.bind_sampler(1, self.gpu.emissive_samplers[mesh.material]);
+                    }
+                    None => {
+                        gl.uniform_1_i32(u.has_emissive_texture.as_ref(), 0);
+                        gl.bind_texture(glow::TEXTURE_2D, None);
+                        gl.bind_sampler(1, None);
+                    }
+                }
+                gl.active_texture(glow::TEXTURE0);
+                match material.base_color_texture {
+                    Some(binding) => {
+                        gl.uniform_1_i32(u.has_texture.as_ref(), 1);
+                        gl.bind_texture(glow::TEXTURE_2D, Some(self.gpu.textures[binding.texture]));
+                        gl.bind_sampler(0, self.gpu.samplers[mesh.material]);
+                    }
+                    None => {
+                        gl.uniform_1_i32(u.has_texture.as_ref(), 0);
+                        gl.bind_texture(glow::TEXTURE_2D, None);
+                        gl.bind_sampler(0, None);
+                    }
+                }
+                gl.bind_vertex_array(Some(gpu_mesh.vertex_array));
+                let mode = match mesh.topology {
+                    Topology::Triangles => glow::TRIANGLES,
+                    Topology::Lines => glow::LINES,
+                    Topology::Points => glow::POINTS,
+                };
+                gl.draw_elements(mode, gpu_mesh.index_count, glow::UNSIGNED_INT, 0);
+            }
+            gl.bind_vertex_array(None);
+            gl.depth_mask(true);
+            gl.color_mask(true, true, true, true);
+            gl.finish();
+        }
+        self.check("rendering the frame")
+    }
+}

@@ -1,0 +1,225 @@
+//! The render target: the single-sample framebuffer frames are read from, the multisampled one
+//! colour frames are drawn into at 4× or 8×, their creation for a view's size and format, and the
+//! resolve between them.
+
+use glow::HasContext;
+use kantele::multisample::SampleCount;
+use kantele::RenderError;
+
+use crate::{backend_error, unsupported, GlBackend};
+
+/// The render target: a framebuffer with a colour and a depth renderbuffer.
+pub(crate) struct Target {
+    pub(crate) framebuffer: glow::Framebuffer,
+    pub(crate) color: glow::Renderbuffer,
+    pub(crate) depth: glow::Renderbuffer,
+    pub(crate) width: u32,
+    pub(crate) height: u32,
+    pub(crate) fast: bool,
+    /// The multisampled framebuffer colour frames are drawn into before they are resolved
+    /// into `framebuffer` (`None` at 1×).
+    pub(crate) multisample: Option<MultisampleTarget>,
+}
+
+/// A multisampled framebuffer of the target's size and formats.
+pub(crate) struct MultisampleTarget {
+    pub(crate) framebuffer: glow::Framebuffer,
+    pub(crate) color: glow::Renderbuffer,
+    pub(crate) depth: glow::Renderbuffer,
+    pub(crate) samples: SampleCount,
+}
+
+impl GlBackend {
+    /// Creates (or re-creates) the framebuffer for the view's size, the selected format and
+    /// `samples` per pixel.
+    pub(crate) fn ensure_target(
+        &mut self,
+        width: u32,
+        height: u32,
+        samples: SampleCount,
+    ) -> Result<(), RenderError> {
+        if let Some(t) = &self.target {
+            let target_samples = t
+                .multisample
+                .as_ref()
+                .map_or(SampleCount::X1, |m| m.samples);
+            if t.width == width
+                && t.height == height
+                && t.fast == self.fast_target
+                && target_samples == samples
+            {
+                return Ok(());
+            }
+        }
+        self.delete_target();
+        let fast = self.fast_target;
+        let gl = &self.gl;
+        // SAFETY: `gl` is current on this thread; the objects are created here and attached
+        // to the framebuffer created here.
+        let target = unsafe {
+            let max = gl.get_parameter_i32(glow::MAX_RENDERBUFFER_SIZE);
+            let mut dims = [0i32; 2];
+            gl.get_parameter_i32_slice(glow::MAX_VIEWPORT_DIMS, &mut dims);
+            if width as i64 > max.min(dims[0]) as i64 || height as i64 > max.min(dims[1]) as i64 {
+                return Err(unsupported(format!(
+                    "target {width}x{height} exceeds the driver's limits (renderbuffer {max}, viewport {}x{})",
+                    dims[0], dims[1]
+                )));
+            }
+            let framebuffer = gl.create_framebuffer().map_err(backend_error)?;
+            let color = gl.create_renderbuffer().map_err(backend_error)?;
+            let depth = gl.create_renderbuffer().map_err(backend_error)?;
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
+            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(color));
+            let color_format = if fast { glow::RGBA8 } else { glow::RGBA32F };
+            gl.renderbuffer_storage(
+                glow::RENDERBUFFER,
+                color_format,
+                width as i32,
+                height as i32,
+            );
+            gl.framebuffer_renderbuffer(
+                glow::FRAMEBUFFER,
+                glow::COLOR_ATTACHMENT0,
+                glow::RENDERBUFFER,
+                Some(color),
+            );
+            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
+            gl.renderbuffer_storage(
+                glow::RENDERBUFFER,
+                glow::DEPTH_COMPONENT32F,
+                width as i32,
+                height as i32,
+            );
+            gl.framebuffer_renderbuffer(
+                glow::FRAMEBUFFER,
+                glow::DEPTH_ATTACHMENT,
+                glow::RENDERBUFFER,
+                Some(depth),
+            );
+            gl.bind_renderbuffer(glow::RENDERBUFFER, None);
+            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            let mut target = Target {
+                framebuffer,
+                color,
+                depth,
+                width,
+                height,
+                fast,
+                multisample: None,
+            };
+            if status != glow::FRAMEBUFFER_COMPLETE {
+                self.target = Some(target);
+                self.delete_target();
+                return Err(backend_error(format!(
+                    "framebuffer {width}x{height} incomplete (status 0x{status:04X})"
+                )));
+            }
+            if samples.is_multisampled() {
+                let ms = MultisampleTarget {
+                    framebuffer: gl.create_framebuffer().map_err(backend_error)?,
+                    color: gl.create_renderbuffer().map_err(backend_error)?,
+                    depth: gl.create_renderbuffer().map_err(backend_error)?,
+                    samples,
+                };
+                let n = samples.count() as i32;
+                gl.bind_framebuffer(glow::FRAMEBUFFER, Some(ms.framebuffer));
+                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(ms.color));
+                gl.renderbuffer_storage_multisample(
+                    glow::RENDERBUFFER,
+                    n,
+                    color_format,
+                    width as i32,
+                    height as i32,
+                );
+                gl.framebuffer_renderbuffer(
+                    glow::FRAMEBUFFER,
+                    glow::COLOR_ATTACHMENT0,
+                    glow::RENDERBUFFER,
+                    Some(ms.color),
+                );
+                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(ms.depth));
+                gl.renderbuffer_storage_multisample(
+                    glow::RENDERBUFFER,
+                    n,
+                    glow::DEPTH_COMPONENT32F,
+                    width as i32,
+                    height as i32,
+                );
+                gl.framebuffer_renderbuffer(
+                    glow::FRAMEBUFFER,
+                    glow::DEPTH_ATTACHMENT,
+                    glow::RENDERBUFFER,
+                    Some(ms.depth),
+                );
+                gl.bind_renderbuffer(glow::RENDERBUFFER, None);
+                let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+                target.multisample = Some(ms);
+                if status != glow::FRAMEBUFFER_COMPLETE {
+                    self.target = Some(target);
+                    self.delete_target();
+                    return Err(unsupported(format!(
+                        "{samples}x multisampled framebuffer {width}x{height} incomplete \
+                         (status 0x{status:04X})"
+                    )));
+                }
+            }
+            target
+        };
+        self.target = Some(target);
+        self.last_pass = None;
+        self.check("creating the framebuffer")
+    }
+
+    pub(crate) fn delete_target(&mut self) {
+        if let Some(t) = self.target.take() {
+            // SAFETY: `gl` is current on this thread and the objects are ours.
+            unsafe {
+                self.gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+                self.gl.delete_framebuffer(t.framebuffer);
+                self.gl.delete_renderbuffer(t.color);
+                self.gl.delete_renderbuffer(t.depth);
+                if let Some(ms) = t.multisample {
+                    self.gl.delete_framebuffer(ms.framebuffer);
+                    self.gl.delete_renderbuffer(ms.color);
+                    self.gl.delete_renderbuffer(ms.depth);
+                }
+            }
+        }
+        self.last_pass = None;
+        self.multisampled_view = None;
+    }
+
+    /// Resolves the multisampled colour into the single-sample target (`glBlitFramebuffer`).
+    pub(crate) fn resolve(&self) -> Result<(), RenderError> {
+        let target = self.target.as_ref().expect("target was created");
+        let Some(ms) = &target.multisample else {
+            return Ok(());
+        };
+        let (w, h) = (target.width as i32, target.height as i32);
+        // SAFETY: `gl` is current on this thread; both framebuffers are ours, complete and of
+        // the same size and colour format.
+        unsafe {
+            let gl = &self.gl;
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(ms.framebuffer));
+            gl.read_buffer(glow::COLOR_ATTACHMENT0);
+            gl.bind_framebuffer(glow::DRAW_FRAMEBUFFER, Some(target.framebuffer));
+            gl.draw_buffers(&[glow::COLOR_ATTACHMENT0]);
+            gl.blit_framebuffer(
+                0,
+                0,
+                w,
+                h,
+                0,
+                0,
+                w,
+                h,
+                glow::COLOR_BUFFER_BIT,
+                glow::NEAREST,
+            );
+            gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+            gl.finish();
+        }
+        self.check("resolving the multisampled frame")
+    }
+}

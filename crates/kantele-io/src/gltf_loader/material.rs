@@ -1,0 +1,271 @@
+//! Materials, their textures and samplers, the images behind them, and the texture coordinates
+//! each material reads.
+
+use std::sync::Arc;
+
+use glam::{Mat3, Vec2, Vec3, Vec4};
+use kantele::scene::{AlphaMode, Material, TextureBinding};
+use kantele::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
+
+use super::{named, Loader};
+use crate::accessor::BufferData;
+use crate::texture_util::{decode_srgb_within, image_size, placeholder, ImageError};
+use crate::uri::read_uri;
+use crate::LoadError;
+
+/// Which texture coordinates a material's textures read: a `TEXCOORD_n` set and a
+/// `KHR_texture_transform` (applied to the mesh's coordinates at load).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct UvMap {
+    /// The `TEXCOORD_n` set.
+    pub(super) set: u32,
+    /// The `KHR_texture_transform` (identity without one).
+    pub(super) transform: Mat3,
+}
+
+impl UvMap {
+    fn of(info: &gltf::texture::Info) -> Self {
+        let mut set = info.tex_coord();
+        let mut transform = Mat3::IDENTITY;
+        if let Some(t) = info.extension_value("KHR_texture_transform") {
+            let pair = |key: &str, default: Vec2| {
+                t.get(key)
+                    .and_then(|v| v.as_array())
+                    .and_then(|a| {
+                        Some(Vec2::new(
+                            a.first()?.as_f64()? as f32,
+                            a.get(1)?.as_f64()? as f32,
+                        ))
+                    })
+                    .unwrap_or(default)
+            };
+            let offset = pair("offset", Vec2::ZERO);
+            let scale = pair("scale", Vec2::ONE);
+            let rotation = t.get("rotation").and_then(|v| v.as_f64()).unwrap_or(0.0) as f32;
+            // uv' = T × R × S × uv. R's columns are (cos, −sin) and (sin, cos): the direction
+            // in which the sample models (TextureTransformTest, TextureTransformMultiTest) and
+            // the common viewers rotate; checked by the corpus test.
+            let (sin, cos) = rotation.sin_cos();
+            let translation = Mat3::from_cols(Vec3::X, Vec3::Y, offset.extend(1.0));
+            let rotation =
+                Mat3::from_cols(Vec3::new(cos, -sin, 0.0), Vec3::new(sin, cos, 0.0), Vec3::Z);
+            let scale = Mat3::from_diagonal(scale.extend(1.0));
+            transform = translation * rotation * scale;
+            if let Some(s) = t.get("texCoord").and_then(|v| v.as_u64()) {
+                set = s as u32;
+            }
+            if !transform.is_finite() {
+                transform = Mat3::IDENTITY;
+            }
+        }
+        Self { set, transform }
+    }
+}
+
+impl Loader<'_> {
+    /// Converts a material; also records which texture coordinates its textures read
+    /// (`self.material_uv`), which the loader bakes into the meshes that use it.
+    pub(super) fn material(&mut self, material: &gltf::Material) -> Result<Material, LoadError> {
+        let name = named(material.name(), "material", material.index().unwrap_or(0));
+        let pbr = material.pbr_metallic_roughness();
+        let (base_color_texture, base_uv) = match pbr.base_color_texture() {
+            Some(info) => (self.texture_binding(&info)?, Some(UvMap::of(&info))),
+            None => (None, None),
+        };
+        let strength = material
+            .extension_value("KHR_materials_emissive_strength")
+            .and_then(|v| v.get("emissiveStrength"))
+            .and_then(serde_json::Value::as_f64)
+            .filter(|s| s.is_finite() && *s >= 0.0)
+            .unwrap_or(1.0) as f32;
+        let mut emissive = Vec3::from(material.emissive_factor()) * strength;
+        if !emissive.is_finite() {
+            emissive = Vec3::ZERO;
+        }
+        let (mut emissive_texture, emissive_uv) = match material.emissive_texture() {
+            Some(info) => (self.texture_binding(&info)?, Some(UvMap::of(&info))),
+            None => (None, None),
+        };
+        let mut uv = base_color_texture.and(base_uv);
+        if emissive_texture.is_some() {
+            match uv {
+                None => uv = emissive_uv,
+                Some(base) if Some(base) != emissive_uv => {
+                    self.info.warn(format!(
+                        "material '{name}': the emissive texture reads other texture coordinates than the base colour texture; its emission is left out"
+                    ));
+                    emissive_texture = None;
+                    emissive = Vec3::ZERO;
+                }
+                Some(_) => {}
+            }
+        }
+        self.material_uv.push(uv);
+        let alpha_mode = match material.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => AlphaMode::Mask {
+                cutoff: material.alpha_cutoff().unwrap_or(0.5),
+            },
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        };
+        if material.unlit() {
+            // KHR_materials_unlit: every property but the base colour is a fallback for viewers
+            // without the extension; the unlit shading adds emission, so drop it here.
+            emissive = Vec3::ZERO;
+            emissive_texture = None;
+        }
+        Ok(Material {
+            name: material.name().unwrap_or_default().to_string(),
+            base_color_factor: Vec4::from(pbr.base_color_factor()),
+            base_color_texture,
+            double_sided: material.double_sided(),
+            alpha_mode,
+            unlit: material.unlit(),
+            emissive,
+            emissive_texture,
+        })
+    }
+
+    fn texture_binding(
+        &mut self,
+        info: &gltf::texture::Info,
+    ) -> Result<Option<TextureBinding>, LoadError> {
+        let texture = info.texture();
+        let Some(image_index) = self
+            .patched
+            .texture_images
+            .get(texture.index())
+            .copied()
+            .flatten()
+        else {
+            return Ok(None);
+        };
+        let texture_index = match self.image_textures.get(&image_index) {
+            Some(&t) => t,
+            None => {
+                let t = self.image(image_index)?;
+                self.image_textures.insert(image_index, t);
+                t
+            }
+        };
+        let Some(texture_index) = texture_index else {
+            return Ok(None);
+        };
+        let s = texture.sampler();
+        let wrap = |mode| match mode {
+            gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+            gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+        };
+        let sampler = Sampler {
+            wrap_s: wrap(s.wrap_s()),
+            wrap_t: wrap(s.wrap_t()),
+            mag_filter: match s.mag_filter() {
+                Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
+                Some(gltf::texture::MagFilter::Linear) | None => Filter::Linear,
+            },
+            min_filter: match s.min_filter() {
+                Some(gltf::texture::MinFilter::Nearest) => MinFilter::Nearest,
+                Some(gltf::texture::MinFilter::Linear) => MinFilter::Linear,
+                Some(gltf::texture::MinFilter::NearestMipmapNearest) => {
+                    MinFilter::NearestMipmapNearest
+                }
+                Some(gltf::texture::MinFilter::LinearMipmapNearest) => {
+                    MinFilter::LinearMipmapNearest
+                }
+                Some(gltf::texture::MinFilter::NearestMipmapLinear) => {
+                    MinFilter::NearestMipmapLinear
+                }
+                Some(gltf::texture::MinFilter::LinearMipmapLinear) | None => {
+                    MinFilter::LinearMipmapLinear
+                }
+            },
+        };
+        Ok(Some(TextureBinding {
+            texture: texture_index,
+            sampler,
+        }))
+    }
+
+    /// Loads one glTF image as an sRGB texture into the scene (once per distinct encoded
+    /// image); `None` when it is missing or cannot be decoded and the load is not strict (a
+    /// warning says so). Budget overruns are always errors.
+    fn image(&mut self, index: usize) -> Result<Option<usize>, LoadError> {
+        let Some(image) = self.document.images().nth(index) else {
+            return Ok(None);
+        };
+        let mut what = format!("image {index}");
+        if let Some(name) = image.name() {
+            what = format!("{what} ('{name}')");
+        }
+        let loaded = match image.source() {
+            gltf::image::Source::View { view, mime_type } => {
+                let data = BufferData {
+                    buffers: self.buffers,
+                    decoded_views: self.decoded_views,
+                };
+                data.view(&view)
+                    .map(|b| (b.to_vec(), Some(mime_type.to_string())))
+            }
+            gltf::image::Source::Uri { uri, mime_type } => {
+                if !uri.starts_with("data:") {
+                    what = format!("{what} from '{uri}'");
+                }
+                read_uri(self.path, uri, self.policy, &mut self.budget)
+                    .map(|b| (b, mime_type.map(str::to_string)))
+            }
+        };
+        let (bytes, mime_type) = match loaded {
+            Ok(loaded) => loaded,
+            Err(e) if e.contains("memory budget") => {
+                return Err(self.invalid(format!("{what}: {e}")))
+            }
+            Err(e) => return self.texture_problem(format!("{what}: {e}")),
+        };
+        if let Some(&t) = self.encoded_images.get(&bytes) {
+            return Ok(Some(t));
+        }
+        let size = match image_size(&bytes, mime_type.as_deref()) {
+            Ok(size) => size,
+            Err(ImageError::Budget(e) | ImageError::Decode(e)) => {
+                return self.texture_problem(format!("{what}: {e}"))
+            }
+        };
+        if !self.options.decode_textures {
+            // Describing the scene: the header's size is reported, nothing is decoded.
+            return Ok(Some(self.push_texture(placeholder(), bytes, size)));
+        }
+        match decode_srgb_within(&bytes, mime_type.as_deref(), &mut self.budget) {
+            Ok(texture) => Ok(Some(self.push_texture(texture, bytes, size))),
+            Err(ImageError::Budget(e)) => Err(self.invalid(format!("{what}: {e}"))),
+            Err(ImageError::Decode(e)) => self.texture_problem(format!("{what}: {e}")),
+        }
+    }
+
+    fn push_texture(&mut self, texture: Texture, encoded: Vec<u8>, size: (u32, u32)) -> usize {
+        self.scene.textures.push(Arc::new(texture));
+        self.info.texture_sizes.push(size);
+        let t = self.scene.textures.len() - 1;
+        self.encoded_images.insert(encoded, t);
+        t
+    }
+
+    /// A texture that cannot be loaded: an error when strict, otherwise a warning and no
+    /// texture.
+    fn texture_problem(&mut self, message: String) -> Result<Option<usize>, LoadError> {
+        if self.options.strict {
+            return Err(self.invalid(message));
+        }
+        self.info.warn(format!(
+            "{message}; drawn untextured (--strict makes this an error)"
+        ));
+        Ok(None)
+    }
+
+    pub(super) fn default_material(&mut self) -> usize {
+        *self.default_material.get_or_insert_with(|| {
+            self.scene.materials.push(Material::default());
+            self.scene.materials.len() - 1
+        })
+    }
+}

@@ -1,0 +1,286 @@
+//! The node hierarchy: the walk from the scene's roots (draws, cameras, the light), instancing
+//! (`EXT_mesh_gpu_instancing`) and the scene's extras.
+
+use glam::{Mat4, Quat, Vec3, Vec4};
+use kantele::scene::{Draw, Light, NamedCamera};
+
+use super::{named, Loader, DEFAULT_RESOLUTION};
+use crate::accessor::{read_f32, BufferData};
+use crate::mesh_util::framing_camera;
+use crate::{LoadError, LoadedScene};
+
+impl Loader<'_> {
+    pub(super) fn run(mut self) -> Result<LoadedScene, LoadError> {
+        let document = self.document;
+        self.info.node_count = document.nodes().len();
+        self.info.cameras = document
+            .cameras()
+            .map(|c| named(c.name(), "camera", c.index()))
+            .collect();
+        self.info.lights = document
+            .lights()
+            .map(|lights| {
+                lights
+                    .map(|l| named(l.name(), "light", l.index()))
+                    .collect()
+            })
+            .unwrap_or_default();
+        for material in document.materials() {
+            let converted = self.material(&material)?;
+            self.scene.materials.push(converted);
+        }
+        if document.skins().len() > 0 {
+            self.info.ignore("skins (meshes drawn in their bind pose)");
+        }
+
+        let Some(gltf_scene) = document
+            .default_scene()
+            .or_else(|| document.scenes().next())
+        else {
+            self.info.warn("the file has no scene: nothing is drawn");
+            self.scene.camera = framing_camera(&self.scene);
+            return Ok(LoadedScene {
+                scene: self.scene,
+                info: self.info,
+            });
+        };
+        self.extras(&gltf_scene);
+
+        let mut camera = None;
+        let mut light = None;
+        let mut visited = vec![false; document.nodes().len()];
+        // Depth first, each node before its children, in file order.
+        let mut stack: Vec<(gltf::Node, Mat4)> =
+            gltf_scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+        stack.reverse();
+        while let Some((node, parent)) = stack.pop() {
+            let index = node.index();
+            if std::mem::replace(&mut visited[index], true) {
+                self.info.warn(format!(
+                    "node {index} is reached more than once (the node hierarchy is not a tree); drawn once"
+                ));
+                continue;
+            }
+            let local = Mat4::from_cols_array_2d(&node.transform().matrix());
+            let world = parent * local;
+            if let Some(c) = self.camera(&node, world) {
+                let name = node
+                    .camera()
+                    .map(|c| named(c.name(), "camera", c.index()))
+                    .unwrap_or_default();
+                self.scene
+                    .file_cameras
+                    .push(NamedCamera { name, camera: c });
+                if camera.is_none() {
+                    camera = Some(c);
+                }
+            }
+            if let Some(l) = node.light() {
+                match l.kind() {
+                    gltf::khr_lights_punctual::Kind::Directional => {
+                        if light.is_none() {
+                            light = Some(Light::Directional {
+                                to_light: world.transform_vector3(Vec3::Z).normalize_or_zero(),
+                                color: Vec3::from(l.color()) * l.intensity(),
+                            });
+                        }
+                    }
+                    _ => self.info.ignore("point and spot lights"),
+                }
+            }
+            if let Some(mesh) = node.mesh() {
+                if node.skin().is_some() {
+                    self.info.ignore("skins (meshes drawn in their bind pose)");
+                }
+                // Default morph weights: the node's, else the mesh's (the rest pose).
+                let weights: Vec<f32> = node
+                    .weights()
+                    .or(mesh.weights())
+                    .map(<[f32]>::to_vec)
+                    .unwrap_or_default();
+                let instances = self.instances(&node, world)?;
+                for primitive in mesh.primitives() {
+                    let key = (
+                        mesh.index(),
+                        primitive.index(),
+                        weights.iter().map(|w| w.to_bits()).collect::<Vec<u32>>(),
+                    );
+                    let mesh_index = match self.primitive_meshes.get(&key) {
+                        Some(&m) => m,
+                        None => {
+                            let m = self.primitive(&mesh, &primitive, &weights)?;
+                            self.primitive_meshes.insert(key, m);
+                            m
+                        }
+                    };
+                    if let Some(mesh_index) = mesh_index {
+                        self.budget
+                            .charge(instances.len() as u64, 128, "the draws of a node")
+                            .map_err(|e| self.invalid(e))?;
+                        for &model in &instances {
+                            self.scene.draws.push(Draw {
+                                mesh: mesh_index,
+                                model,
+                                node_name: node.name().unwrap_or_default().to_string(),
+                                node_index: index,
+                            });
+                        }
+                    }
+                }
+            }
+            let children: Vec<_> = node.children().collect();
+            for child in children.into_iter().rev() {
+                stack.push((child, world));
+            }
+        }
+
+        self.scene.light = light.unwrap_or(Light::Headlight);
+        match camera {
+            Some(camera) => {
+                self.scene.camera = camera;
+                self.info.camera_from_file = true;
+            }
+            None => {
+                self.scene.camera = framing_camera(&self.scene);
+                self.info.camera_from_file = false;
+            }
+        }
+        self.scene
+            .validate()
+            .map_err(|e| self.invalid(e.to_string()))?;
+        Ok(LoadedScene {
+            scene: self.scene,
+            info: self.info,
+        })
+    }
+
+    /// The model matrices a node's mesh is drawn with: its world matrix, or one per instance of
+    /// `EXT_mesh_gpu_instancing` (world × the instance's TRS).
+    fn instances(&mut self, node: &gltf::Node, world: Mat4) -> Result<Vec<Mat4>, LoadError> {
+        let Some(ext) = node.extension_value("EXT_mesh_gpu_instancing") else {
+            return Ok(vec![world]);
+        };
+        let what = format!("node {} (EXT_mesh_gpu_instancing)", node.index());
+        let attributes = ext.get("attributes").and_then(|a| a.as_object());
+        let data = BufferData {
+            buffers: self.buffers,
+            decoded_views: self.decoded_views,
+        };
+        let mut read = |name: &str, components: usize| -> Result<Option<Vec<f32>>, LoadError> {
+            let Some(index) = attributes
+                .and_then(|a| a.get(name))
+                .and_then(|v| v.as_u64())
+            else {
+                return Ok(None);
+            };
+            let accessor = self
+                .document
+                .accessors()
+                .nth(index as usize)
+                .ok_or_else(|| {
+                    LoadError::invalid(self.path, format!("{what}: no accessor {index}"))
+                })?;
+            if accessor.dimensions().multiplicity() != components {
+                return Err(LoadError::invalid(
+                    self.path,
+                    format!("{what}: {name} accessor {index} has the wrong type"),
+                ));
+            }
+            let label = format!("{what}: {name} accessor {index}");
+            read_f32(&data, &accessor, &mut self.budget, &label)
+                .map(Some)
+                .map_err(|e| LoadError::invalid(self.path, e))
+        };
+        let translation = read("TRANSLATION", 3)?;
+        let rotation = read("ROTATION", 4)?;
+        let scale = read("SCALE", 3)?;
+        let counts = [
+            translation.as_ref().map(|t| t.len() / 3),
+            rotation.as_ref().map(|r| r.len() / 4),
+            scale.as_ref().map(|s| s.len() / 3),
+        ];
+        let mut known = counts.iter().flatten();
+        let Some(&count) = known.next() else {
+            return Ok(vec![world]);
+        };
+        if known.any(|&c| c != count) {
+            return Err(self.invalid(format!(
+                "{what}: the instance attributes have different counts"
+            )));
+        }
+        let mut models =
+            crate::budget::vec_with_capacity(count, &what).map_err(|e| self.invalid(e))?;
+        for i in 0..count {
+            let t = translation
+                .as_ref()
+                .map_or(Vec3::ZERO, |t| Vec3::from_slice(&t[3 * i..]));
+            let r = rotation.as_ref().map_or(Quat::IDENTITY, |r| {
+                let q = Vec4::from_slice(&r[4 * i..]);
+                q.try_normalize().map_or(Quat::IDENTITY, Quat::from_vec4)
+            });
+            let s = scale
+                .as_ref()
+                .map_or(Vec3::ONE, |s| Vec3::from_slice(&s[3 * i..]));
+            models.push(world * Mat4::from_scale_rotation_translation(s, r, t));
+        }
+        Ok(models)
+    }
+
+    /// Reads `resolution`, `clear_color` and `ambient` from the scene's extras.
+    fn extras(&mut self, gltf_scene: &gltf::Scene) {
+        self.scene.resolution = DEFAULT_RESOLUTION;
+        self.scene.clear_color = Vec4::new(0.0, 0.0, 0.0, 1.0);
+        self.scene.ambient = 0.1;
+        let Some(raw) = gltf_scene.extras() else {
+            return;
+        };
+        let value: serde_json::Value = match serde_json::from_str(raw.get()) {
+            Ok(v) => v,
+            Err(e) => {
+                self.info
+                    .warn(format!("scene extras are not valid JSON ({e}); ignored"));
+                return;
+            }
+        };
+        let numbers = |v: &serde_json::Value| -> Option<Vec<f64>> {
+            v.as_array()?
+                .iter()
+                .map(serde_json::Value::as_f64)
+                .collect()
+        };
+        if let Some(v) = value.get("resolution") {
+            let max = kantele::MAX_TARGET_SIZE as f64;
+            match numbers(v).as_deref() {
+                Some(&[w, h])
+                    if w >= 1.0 && h >= 1.0 && w <= max && h <= max && w.fract() == 0.0 && h.fract() == 0.0 =>
+                {
+                    self.scene.resolution = (w as u32, h as u32);
+                }
+                _ => self.info.warn(format!(
+                    "scene extras: resolution {v} is not [width, height] in 1..={max}; using 800x600"
+                )),
+            }
+        }
+        if let Some(v) = value.get("clear_color") {
+            match numbers(v).as_deref() {
+                Some(&[r, g, b, a]) if [r, g, b, a].iter().all(|c| c.is_finite()) => {
+                    self.scene.clear_color = Vec4::new(r as f32, g as f32, b as f32, a as f32);
+                }
+                Some(&[r, g, b]) if [r, g, b].iter().all(|c| c.is_finite()) => {
+                    self.scene.clear_color = Vec4::new(r as f32, g as f32, b as f32, 1.0);
+                }
+                _ => self.info.warn(format!(
+                    "scene extras: clear_color {v} is not [r, g, b, a]; using black"
+                )),
+            }
+        }
+        if let Some(v) = value.get("ambient") {
+            match v.as_f64() {
+                Some(a) if a.is_finite() => self.scene.ambient = a as f32,
+                _ => self.info.warn(format!(
+                    "scene extras: ambient {v} is not a number; using 0.1"
+                )),
+            }
+        }
+    }
+}
