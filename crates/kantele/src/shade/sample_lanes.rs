@@ -4,7 +4,10 @@
 //! The rules are those of the scalar sampler ([`Texture::sample_lod`]): the level of detail per
 //! lane from the analytic derivatives (OpenGL 4.6 §8.14), magnification or minification per
 //! lane, every wrap mode and every filter. Texels are fetched with [`I32x8::gather_u32`] (each
-//! lane's level offset and size gathered from the level table), unpacked and decoded lane-wide.
+//! lane's level offset and size gathered from the level table), or, where the two columns of
+//! every lane's bilinear footprint are neighbours in memory, one row's two texels at once with
+//! [`TexelGather::gather_u32_pair`]; sRGB bytes are decoded lane-wide through the 256-entry
+//! table ([`TexelGather::lookup_rgb`]).
 //! Every step is the same `f32` / `i32` operation in the same order on every instruction set (no
 //! fused multiply-add), so the scalar build and the SIMD builds give identical bits.
 //!
@@ -12,7 +15,7 @@
 //! (absolute error below 1e-6 for the level of detail), and linear channels (alpha, and all four
 //! in a linear texture) are filtered as bytes and divided by 255 once at the end.
 
-use crate::simd::{F32x8, I32x8, Lanes, Mask8, MaskOf};
+use crate::simd::{F32x8, I32x8, Lanes, Mask8, MaskOf, TexelGather};
 
 use super::texel::decode_table;
 use super::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
@@ -150,10 +153,21 @@ impl Texture {
         let x1 = sampler.wrap_s.wrap_lanes::<L>(i0 + one, width);
         let row0 = offset + sampler.wrap_t.wrap_lanes::<L>(j0, height) * width;
         let row1 = offset + sampler.wrap_t.wrap_lanes::<L>(j0 + one, height) * width;
-        let t00 = self.fetch_lanes::<L>(row0 + x0);
-        let t10 = self.fetch_lanes::<L>(row0 + x1);
-        let t01 = self.fetch_lanes::<L>(row1 + x0);
-        let t11 = self.fetch_lanes::<L>(row1 + x1);
+        // Where every live lane's two columns are neighbours in memory (no wrap between them,
+        // the common case), each row's pair of texels is one 8-byte read per lane.
+        let neighbours = x1.simd_eq(x0 + one).or(live.not()).all();
+        let (t00, t10, t01, t11) = if neighbours {
+            let (t00, t10) = self.fetch_pair_lanes::<L>(row0 + x0);
+            let (t01, t11) = self.fetch_pair_lanes::<L>(row1 + x0);
+            (t00, t10, t01, t11)
+        } else {
+            (
+                self.fetch_lanes::<L>(row0 + x0),
+                self.fetch_lanes::<L>(row0 + x1),
+                self.fetch_lanes::<L>(row1 + x0),
+                self.fetch_lanes::<L>(row1 + x1),
+            )
+        };
         let (one_alpha, one_beta) = (lanes.splat_f32(1.0) - alpha, lanes.splat_f32(1.0) - beta);
         // Plain loops, not closures: a closure would be compiled without the instruction set's
         // target feature and call the lane operations out of line.
@@ -192,28 +206,48 @@ impl Texture {
         }
     }
 
-    /// Gathers the texels at `index` and unpacks them: red, green and blue decoded through the
-    /// sRGB table in an sRGB texture, otherwise every channel as its raw byte value (0–255).
+    /// Gathers the texels at `index` and unpacks them ([`Texture::unpack_lanes`]).
     #[inline(always)]
     fn fetch_lanes<L: Lanes>(&self, index: L::I32) -> Channels<L> {
-        let lanes = index.lanes();
-        let texel = index.gather_u32(&self.texels);
-        let byte = lanes.splat_i32(0xff);
-        let r = texel & byte;
-        let g = texel.shr_logical::<8>() & byte;
-        let b = texel.shr_logical::<16>() & byte;
+        self.unpack_lanes::<L>(index.gather_u32(&self.texels))
+    }
+
+    /// The texels at `index` and `index + 1` (one 8-byte read per lane), unpacked
+    /// ([`Texture::unpack_lanes`]). `index + 1` must lie in the texture's storage for live lanes.
+    #[inline(always)]
+    fn fetch_pair_lanes<L: Lanes>(&self, index: L::I32) -> (Channels<L>, Channels<L>) {
+        let (first, second) = index.gather_u32_pair(&self.texels);
+        (
+            self.unpack_lanes::<L>(first),
+            self.unpack_lanes::<L>(second),
+        )
+    }
+
+    /// Unpacks packed texels: red, green and blue decoded through the sRGB table in an sRGB
+    /// texture, otherwise every channel as its raw byte value (0–255); alpha always raw.
+    #[inline(always)]
+    fn unpack_lanes<L: Lanes>(&self, texel: L::I32) -> Channels<L> {
+        let lanes = texel.lanes();
         let a = texel.shr_logical::<24>().to_f32();
         match self.color_space {
             ColorSpace::Srgb => {
-                let table = decode_table(ColorSpace::Srgb);
+                let [r, g, b] = texel.lookup_rgb(decode_table(ColorSpace::Srgb));
                 [
-                    L::F32::from_bits(r.gather_u32(table)),
-                    L::F32::from_bits(g.gather_u32(table)),
-                    L::F32::from_bits(b.gather_u32(table)),
+                    L::F32::from_bits(r),
+                    L::F32::from_bits(g),
+                    L::F32::from_bits(b),
                     a,
                 ]
             }
-            ColorSpace::Linear => [r.to_f32(), g.to_f32(), b.to_f32(), a],
+            ColorSpace::Linear => {
+                let byte = lanes.splat_i32(0xff);
+                [
+                    (texel & byte).to_f32(),
+                    (texel.shr_logical::<8>() & byte).to_f32(),
+                    (texel.shr_logical::<16>() & byte).to_f32(),
+                    a,
+                ]
+            }
         }
     }
 }

@@ -458,3 +458,66 @@ impl Mask8 for Avx2Mask {
         ))))
     }
 }
+
+// --- TexelGather: the texture sampler's lane operations (issue 7, `tex` round) ---
+
+impl super::TexelGather for Avx2I32 {
+    #[inline(always)]
+    fn gather_u32_pair(self, table: &[u32]) -> (Self, Self) {
+        let Some(last) = table.len().checked_sub(2) else {
+            return avx!((
+                Avx2I32(_mm256_setzero_si256()),
+                Avx2I32(_mm256_setzero_si256())
+            ));
+        };
+        let last = i32::try_from(last).unwrap_or(i32::MAX);
+        avx!({
+            // Every clamped index is in `0..=table.len() - 2`, so every 8-byte read (entries
+            // `c` and `c + 1`) is inside `table`.
+            let index = _mm256_min_epi32(
+                _mm256_max_epi32(self.0, _mm256_setzero_si256()),
+                _mm256_set1_epi32(last),
+            );
+            let base: *const i64 = table.as_ptr().cast();
+            // [a0 b0 a1 b1 | a2 b2 a3 b3] and [a4 b4 a5 b5 | a6 b6 a7 b7] (a = table[c],
+            // b = table[c + 1], one 64-bit element per lane).
+            let low = _mm256_castsi256_ps(_mm256_i32gather_epi64::<4>(
+                base,
+                _mm256_castsi256_si128(index),
+            ));
+            let high = _mm256_castsi256_ps(_mm256_i32gather_epi64::<4>(
+                base,
+                _mm256_extracti128_si256::<1>(index),
+            ));
+            // [a0 a1 a4 a5 | a2 a3 a6 a7], then the 64-bit quarters in the order 0, 2, 1, 3.
+            let first = _mm256_castps_si256(_mm256_shuffle_ps::<0b10_00_10_00>(low, high));
+            let second = _mm256_castps_si256(_mm256_shuffle_ps::<0b11_01_11_01>(low, high));
+            (
+                Avx2I32(_mm256_permute4x64_epi64::<0b11_01_10_00>(first)),
+                Avx2I32(_mm256_permute4x64_epi64::<0b11_01_10_00>(second)),
+            )
+        })
+    }
+
+    #[inline(always)]
+    fn lookup_rgb(self, table: &[u32; 256]) -> [Self; 3] {
+        let byte = avx!(_mm256_set1_epi32(0xff));
+        let base: *const i32 = table.as_ptr().cast();
+        // Every index is a byte, below the table's 256 entries: no clamping needed. (24 scalar
+        // loads instead: 25-37% more instructions per frame, no faster on AMD Zen.)
+        avx!([
+            Avx2I32(_mm256_i32gather_epi32::<4>(
+                base,
+                _mm256_and_si256(self.0, byte)
+            )),
+            Avx2I32(_mm256_i32gather_epi32::<4>(
+                base,
+                _mm256_and_si256(_mm256_srli_epi32::<8>(self.0), byte),
+            )),
+            Avx2I32(_mm256_i32gather_epi32::<4>(
+                base,
+                _mm256_and_si256(_mm256_srli_epi32::<16>(self.0), byte),
+            )),
+        ])
+    }
+}

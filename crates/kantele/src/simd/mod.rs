@@ -85,6 +85,8 @@ mod scalar;
 mod sse2;
 #[cfg(test)]
 mod tests;
+// The texture sampler's lane operations (issue 7, `tex` round).
+mod texel_gather;
 
 #[cfg(target_arch = "x86_64")]
 pub use avx2::{Avx2, Avx2F32, Avx2I32, Avx2Mask};
@@ -94,6 +96,7 @@ pub use rounding::{floor, round_ties_even};
 pub use scalar::{Scalar, ScalarF32, ScalarI32, ScalarMask};
 #[cfg(target_arch = "x86_64")]
 pub use sse2::{Sse2, Sse41, SseF32, SseI32, SseLevel, SseMask};
+pub use texel_gather::TexelGather;
 
 /// The environment variable that forces an instruction set (see [`Isa::from_env`]).
 pub const ISA_ENV: &str = "KANTELE_ISA";
@@ -277,7 +280,7 @@ pub trait Lanes: Copy + fmt::Debug + Send + Sync + 'static {
     /// 8 × `f32`.
     type F32: F32x8<Lanes = Self>;
     /// 8 × `i32`.
-    type I32: I32x8<Lanes = Self>;
+    type I32: I32x8<Lanes = Self> + TexelGather;
     /// 8 lane booleans.
     type Mask: Mask8<Lanes = Self>;
 

@@ -1,0 +1,187 @@
+//! Lane operations of the texture sampler (issue 7, `tex` round): fetching two neighbouring
+//! texels per lane at once, and decoding the red, green and blue bytes of packed texels through
+//! a 256-entry table.
+//!
+//! [`TexelGather`] is a separate trait (every [`Lanes::I32`](super::Lanes::I32) implements it)
+//! so the sampler's operations stay in one block. The readable reference is written on arrays
+//! with scalar loads; the scalar, SSE2/SSE4.1 and NEON implementations use it as it is (SSE and
+//! NEON have no gather instruction). AVX2 fetches pairs with two `vpgatherdq` and decodes with
+//! three `vpgatherdd` (in `avx2.rs`, the block marked `TexelGather`). Every implementation
+//! returns the same bits for every input: they are table reads.
+
+use super::{I32x8, Lanes};
+
+/// Texel fetches for the lane-wide sampler.
+pub trait TexelGather: I32x8 {
+    /// Two neighbouring table entries per lane: lane `k` of the first result is `table[c]` and of
+    /// the second `table[c + 1]`, with `c = clamp(self[k], 0, table.len() - 2)`; all zeros when
+    /// `table` has fewer than two entries. One read of 8 bytes per lane on AVX2 (`vpgatherdq`):
+    /// the two texels of a bilinear footprint's row, when they are neighbours in memory.
+    fn gather_u32_pair(self, table: &[u32]) -> (Self, Self);
+
+    /// Bytes 0, 1 and 2 of each lane (red, green and blue of a packed texel) decoded through a
+    /// 256-entry table: lane `k` of result `c` is `table[(self[k] >> 8c) & 0xff]`.
+    fn lookup_rgb(self, table: &[u32; 256]) -> [Self; 3];
+}
+
+/// [`TexelGather::gather_u32_pair`] on plain arrays: the reference.
+#[inline(always)]
+fn gather_pair_reference(index: [i32; 8], table: &[u32]) -> ([i32; 8], [i32; 8]) {
+    let mut first = [0i32; 8];
+    let mut second = [0i32; 8];
+    let Some(last) = table.len().checked_sub(2) else {
+        return (first, second);
+    };
+    for k in 0..8 {
+        let c = usize::try_from(index[k]).unwrap_or(0).min(last);
+        first[k] = table[c] as i32;
+        second[k] = table[c + 1] as i32;
+    }
+    (first, second)
+}
+
+/// [`TexelGather::lookup_rgb`] on plain arrays: the reference.
+#[inline(always)]
+fn lookup_rgb_reference(packed: [i32; 8], table: &[u32; 256]) -> [[i32; 8]; 3] {
+    let mut out = [[0i32; 8]; 3];
+    for k in 0..8 {
+        let [r, g, b, _] = packed[k].to_le_bytes();
+        out[0][k] = table[r as usize] as i32;
+        out[1][k] = table[g as usize] as i32;
+        out[2][k] = table[b as usize] as i32;
+    }
+    out
+}
+
+/// Implements [`TexelGather`] with the array references (scalar loads).
+macro_rules! texel_gather_by_reference {
+    ($(#[$attr:meta])* impl $(<$param:ident: $bound:path>)? for $ty:ty) => {
+        $(#[$attr])*
+        impl$(<$param: $bound>)? TexelGather for $ty {
+            #[inline(always)]
+            fn gather_u32_pair(self, table: &[u32]) -> (Self, Self) {
+                let lanes = self.lanes();
+                let (first, second) = gather_pair_reference(self.to_array(), table);
+                (lanes.i32_from_array(first), lanes.i32_from_array(second))
+            }
+
+            #[inline(always)]
+            fn lookup_rgb(self, table: &[u32; 256]) -> [Self; 3] {
+                let lanes = self.lanes();
+                let [r, g, b] = lookup_rgb_reference(self.to_array(), table);
+                [
+                    lanes.i32_from_array(r),
+                    lanes.i32_from_array(g),
+                    lanes.i32_from_array(b),
+                ]
+            }
+        }
+    };
+}
+
+texel_gather_by_reference!(impl for super::scalar::ScalarI32);
+texel_gather_by_reference!(
+    #[cfg(target_arch = "x86_64")]
+    impl<T: super::sse2::SseLevel> for super::sse2::SseI32<T>
+);
+texel_gather_by_reference!(
+    #[cfg(target_arch = "aarch64")]
+    impl for super::neon::NeonI32
+);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::simd::{dispatch, Isa, LaneKernel};
+
+    struct Pair<'a> {
+        index: [i32; 8],
+        table: &'a [u32],
+    }
+
+    impl LaneKernel for Pair<'_> {
+        type Output = ([i32; 8], [i32; 8]);
+        #[inline(always)]
+        fn run<L: Lanes>(self, lanes: L) -> Self::Output {
+            let (a, b) = lanes.i32_from_array(self.index).gather_u32_pair(self.table);
+            (a.to_array(), b.to_array())
+        }
+    }
+
+    struct Bytes<'a> {
+        packed: [i32; 8],
+        table: &'a [u32; 256],
+    }
+
+    impl LaneKernel for Bytes<'_> {
+        type Output = [[i32; 8]; 3];
+        #[inline(always)]
+        fn run<L: Lanes>(self, lanes: L) -> Self::Output {
+            let [r, g, b] = lanes.i32_from_array(self.packed).lookup_rgb(self.table);
+            [r.to_array(), g.to_array(), b.to_array()]
+        }
+    }
+
+    fn isas() -> Vec<Isa> {
+        Isa::ALL.into_iter().filter(|i| i.is_supported()).collect()
+    }
+
+    #[test]
+    fn pairs_are_neighbouring_entries_with_clamped_indices() {
+        let edges = [i32::MIN, -1, 0, 1, 5, 6, 7, 8, 1000, i32::MAX];
+        for len in [0usize, 1, 2, 3, 8, 9] {
+            let table: Vec<u32> = (0..len as u32)
+                .map(|i| 0x8000_0001u32.wrapping_mul(i + 1))
+                .collect();
+            for start in 0..edges.len() {
+                let index: [i32; 8] = std::array::from_fn(|k| edges[(start + k) % edges.len()]);
+                let expected: ([i32; 8], [i32; 8]) = if len < 2 {
+                    ([0; 8], [0; 8])
+                } else {
+                    let c = |k: usize| (index[k].max(0) as usize).min(len - 2);
+                    (
+                        std::array::from_fn(|k| table[c(k)] as i32),
+                        std::array::from_fn(|k| table[c(k) + 1] as i32),
+                    )
+                };
+                for isa in isas() {
+                    let got = dispatch(
+                        isa,
+                        Pair {
+                            index,
+                            table: &table,
+                        },
+                    );
+                    assert_eq!(got, expected, "{isa}, {len} entries, {index:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn bytes_are_decoded_through_the_table() {
+        let table: [u32; 256] = std::array::from_fn(|k| (k as u32).wrapping_mul(0x9e37_79b9));
+        let mut state = 0x1234_5678u32;
+        for _ in 0..64 {
+            let packed: [i32; 8] = std::array::from_fn(|_| {
+                state ^= state << 13;
+                state ^= state >> 17;
+                state ^= state << 5;
+                state as i32
+            });
+            let expected: [[i32; 8]; 3] = std::array::from_fn(|byte| {
+                std::array::from_fn(|k| table[packed[k].to_le_bytes()[byte] as usize] as i32)
+            });
+            for isa in isas() {
+                let got = dispatch(
+                    isa,
+                    Bytes {
+                        packed,
+                        table: &table,
+                    },
+                );
+                assert_eq!(got, expected, "{isa}");
+            }
+        }
+    }
+}
