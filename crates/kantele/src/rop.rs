@@ -10,7 +10,7 @@ use glam::Vec4;
 pub use crate::state::{BlendMode, DepthFunc};
 
 use crate::error::RenderError;
-use crate::fixed::{BLOCK_LOG2, TILE_LOG2, TILE_PIXELS, TILE_SIZE};
+use crate::fixed::{BLOCK_LOG2, BLOCK_SIZE, TILE_LOG2, TILE_PIXELS, TILE_SIZE};
 use crate::multisample::{SampleCount, MAX_MULTISAMPLE_TARGET_BYTES};
 
 /// 8 × 8 blocks in a tile (64).
@@ -248,22 +248,47 @@ impl TileBuffer {
         if self.depth_bound_exact || area < DEPTH_BOUND_REFRESH_AREA.min(tile_area / 4) {
             return false;
         }
-        // Only pixels on the target: those past its edge keep the clear value forever. Every
-        // depth plane (the pixel centres' and, when multisampled, each sample's).
-        let mut bound = f32::NEG_INFINITY;
-        for plane in self.depth.chunks_exact(TILE_PIXELS) {
-            for y in tile.y0..tile.y1 {
-                let row = Self::index(tile.x0, y);
-                let width = tile.width() as usize;
-                bound = plane[row..row + width]
-                    .iter()
-                    .copied()
-                    .fold(bound, f32::max);
-            }
-        }
-        self.depth_bound = bound;
+        self.depth_bound = self.exact_depth_bound(tile);
         self.depth_bound_exact = true;
         min_depth > self.depth_bound
+    }
+
+    /// The largest depth of the tile's pixels on the target (`tile` is the tile's rectangle on
+    /// it; pixels past its edge keep the clear value forever), over every depth plane (the
+    /// pixel centres' and, when multisampled, each sample's). A block wholly on the target
+    /// gives its exact maximum, kept by the per-pixel paths, so only blocks cut by the
+    /// target's edge are read pixel by pixel: 64 values instead of 4096 for an inner tile.
+    fn exact_depth_bound(&self, tile: &PixelRect) -> f32 {
+        let block = BLOCK_SIZE as i32;
+        let mut bound = f32::NEG_INFINITY;
+        for by in 0..(TILE_SIZE as i32 / block) {
+            let y0 = tile.y0 + by * block;
+            let y1 = (y0 + block).min(tile.y1);
+            if y0 >= y1 {
+                break;
+            }
+            for bx in 0..(TILE_SIZE as i32 / block) {
+                let x0 = tile.x0 + bx * block;
+                let x1 = (x0 + block).min(tile.x1);
+                if x0 >= x1 {
+                    break;
+                }
+                if y1 - y0 == block && x1 - x0 == block {
+                    bound = bound.max(self.block_depth_max[Self::block_index(x0, y0)]);
+                    continue;
+                }
+                for plane in self.depth.chunks_exact(TILE_PIXELS) {
+                    for y in y0..y1 {
+                        let row = Self::index(x0, y);
+                        bound = plane[row..row + (x1 - x0) as usize]
+                            .iter()
+                            .copied()
+                            .fold(bound, f32::max);
+                    }
+                }
+            }
+        }
+        bound
     }
 
     /// Index of absolute pixel `(x, y)` within the tile (the tile's origin is a multiple of
