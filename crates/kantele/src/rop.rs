@@ -43,6 +43,35 @@ pub struct TileBuffer {
     block_depth_max: [f32; BLOCKS_PER_TILE],
 }
 
+/// Pixels from the first of an 8 × 8 block to its last, in a tile's row-major order: seven
+/// tile rows and one block row.
+pub const BLOCK_SPAN: usize = (BLOCK_SIZE as usize - 1) * TILE_SIZE as usize + BLOCK_SIZE as usize;
+
+/// The depth and colour (red, green, blue, alpha planes) of one 8 × 8 block of a single-sample
+/// tile, each from the block's first pixel on: block row `r` starts at `r · TILE_SIZE`.
+pub struct BlockRows<'a> {
+    /// Window depths.
+    pub depth: &'a mut [f32; BLOCK_SPAN],
+    /// Linear colour planes.
+    pub color: [&'a mut [f32; BLOCK_SPAN]; 4],
+}
+
+impl BlockRows<'_> {
+    /// Offset of block row `row` (0..8) from the block's first pixel.
+    #[inline(always)]
+    pub fn row_offset(row: usize) -> usize {
+        row * TILE_SIZE as usize
+    }
+}
+
+/// The [`BLOCK_SPAN`] values of `plane` from the block's first pixel `first` on.
+#[inline(always)]
+fn block_span(plane: &mut [f32], first: usize) -> &mut [f32; BLOCK_SPAN] {
+    plane[first..]
+        .first_chunk_mut::<BLOCK_SPAN>()
+        .expect("an 8 x 8 block lies inside its tile")
+}
+
 /// Margin below a triangle's smallest vertex depth. Interpolated depth is clamped to the
 /// vertex range (`TriangleSetup::depth_at`), so none is needed; this is belt and braces.
 const DEPTH_BOUND_SLACK: f32 = 1e-6;
@@ -75,6 +104,26 @@ impl TileBuffer {
     #[inline(always)]
     pub fn depth_row_mut(&mut self, index: usize) -> &mut [f32] {
         &mut self.depth[index..]
+    }
+
+    /// The depth and colour rows of the 8 × 8 block whose first pixel has tile index `first`
+    /// (single-sample tiles): fixed-size views, so the per-pixel loop indexes its rows without
+    /// bounds checks.
+    #[inline(always)]
+    pub fn block_rows_mut(&mut self, first: usize) -> BlockRows<'_> {
+        debug_assert_eq!(self.samples, 1);
+        let (r, rest) = self.color.split_at_mut(TILE_PIXELS);
+        let (g, rest) = rest.split_at_mut(TILE_PIXELS);
+        let (b, a) = rest.split_at_mut(TILE_PIXELS);
+        BlockRows {
+            depth: block_span(&mut self.depth, first),
+            color: [
+                block_span(r, first),
+                block_span(g, first),
+                block_span(b, first),
+                block_span(a, first),
+            ],
+        }
     }
 
     /// Samples per pixel of this tile.

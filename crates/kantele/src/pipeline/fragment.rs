@@ -13,11 +13,11 @@ use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::draw::{DrawCall, DrawJob};
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
-use super::shader::{FragmentLanes, Interpolation, Shader};
+use super::shader::{vertex_varyings, FragmentLanes, Interpolation, Shader};
 use crate::fixed::pixel_center;
 use crate::raster::bin::TileBins;
 use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
-use crate::rop::{BlendMode, Framebuffer, TileBuffer};
+use crate::rop::{BlendMode, BlockRows, Framebuffer, TileBuffer};
 use crate::setup::TriangleSetup;
 use crate::simd::{dispatch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
 
@@ -246,8 +246,9 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
         let state = &draw.state;
         let shader = draw.shader;
         let (dl_dx, dl_dy) = tri.barycentric_gradients();
+        let vertex_attrs = vertex_varyings(attrs);
         let interpolation = Interpolation {
-            attrs,
+            attrs: &vertex_attrs,
             varying_count: shader.varying_count(),
             inv_w: tri.inv_w,
             dl_dx,
@@ -280,12 +281,14 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
             let mut shaded_bits = 0u64;
             let mut kept_bits = 0u64;
             let columns = triangle.column_terms(lanes, pixel_center(block.x as i64) - v0x);
+            let rows = tile.block_rows_mut(TileBuffer::index(block.x, block.y));
             for row in 0..8 {
                 let row_bits = (block.mask >> (8 * row)) as u8;
                 if row_bits == 0 {
                     continue;
                 }
-                let (x, y) = (block.x, block.y + row);
+                let (x, y) = (block.x, block.y + row as i32);
+                let at = BlockRows::row_offset(row);
                 let bary =
                     triangle.barycentrics_in_row(lanes, &columns, pixel_center(y as i64) - v0y);
                 let depth = triangle.depth(bary);
@@ -294,9 +297,8 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                     // Outside [0, 1] (or NaN): beyond the near or far plane.
                     active = active.and(depth.simd_ge(zero)).and(depth.simd_le(one));
                 }
-                let index = TileBuffer::index(x, y);
                 if state.depth_test {
-                    let stored = lanes.load_f32(tile.depth_row(index));
+                    let stored = lanes.load_f32(&rows.depth[at..at + 8]);
                     active = active.and(state.depth_func.passes_lanes(lanes, depth, stored));
                 }
                 let active_bits = active.bits();
@@ -329,12 +331,11 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 let (src, nan_src) = zero_nan_channels(lanes, shaded.color, keep);
                 counters.nan_channels += nan_src;
                 let blended = if blend_reads_target {
-                    let [r, g, b, a] = tile.color_row(index);
                     let dst = [
-                        lanes.load_f32(r),
-                        lanes.load_f32(g),
-                        lanes.load_f32(b),
-                        lanes.load_f32(a),
+                        lanes.load_f32(&rows.color[0][at..at + 8]),
+                        lanes.load_f32(&rows.color[1][at..at + 8]),
+                        lanes.load_f32(&rows.color[2][at..at + 8]),
+                        lanes.load_f32(&rows.color[3][at..at + 8]),
                     ];
                     let blended = state.blend.blend_lanes(lanes, src, dst);
                     let (blended, nan_blended) = zero_nan_channels(lanes, blended, keep);
@@ -343,13 +344,11 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 } else {
                     src
                 };
-                let [r, g, b, a] = tile.color_row_mut(index);
-                blended[0].store_masked(keep, r);
-                blended[1].store_masked(keep, g);
-                blended[2].store_masked(keep, b);
-                blended[3].store_masked(keep, a);
+                for c in 0..4 {
+                    blended[c].store_masked(keep, &mut rows.color[c][at..at + 8]);
+                }
                 if state.depth_write {
-                    depth.store_masked(keep, tile.depth_row_mut(index));
+                    depth.store_masked(keep, &mut rows.depth[at..at + 8]);
                 }
             }
             let shaded_count = shaded_bits.count_ones() as u64;
@@ -357,11 +356,10 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
             counters.discarded += shaded_count - kept_bits.count_ones() as u64;
             if state.depth_write && kept_bits != 0 {
                 // Keep the block's bound exact: the largest of its 64 depths.
-                let first = TileBuffer::index(block.x, block.y);
-                let row_stride = crate::fixed::TILE_SIZE as usize;
-                let mut largest = lanes.load_f32(tile.depth_row(first));
+                let mut largest = lanes.load_f32(&rows.depth[..8]);
                 for row in 1..8 {
-                    largest = largest.max(lanes.load_f32(tile.depth_row(first + row * row_stride)));
+                    let at = BlockRows::row_offset(row);
+                    largest = largest.max(lanes.load_f32(&rows.depth[at..at + 8]));
                 }
                 tile.set_block_depth_max(block_index, largest.reduce_max());
             }
