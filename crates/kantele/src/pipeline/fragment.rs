@@ -281,7 +281,7 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
             let mut shaded_bits = 0u64;
             let mut kept_bits = 0u64;
             let columns = triangle.column_terms(lanes, pixel_center(block.x as i64) - v0x);
-            let rows = tile.block_rows_mut(TileBuffer::index(block.x, block.y));
+            let mut rows = tile.block_rows_mut(TileBuffer::index(block.x, block.y));
             for row in 0..8 {
                 let row_bits = (block.mask >> (8 * row)) as u8;
                 if row_bits == 0 {
@@ -344,9 +344,11 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 } else {
                     src
                 };
-                for c in 0..4 {
-                    blended[c].store_masked(keep, &mut rows.color[c][at..at + 8]);
-                }
+                let [r, g, b, a] = &mut rows.color;
+                blended[0].store_masked(keep, &mut r[at..at + 8]);
+                blended[1].store_masked(keep, &mut g[at..at + 8]);
+                blended[2].store_masked(keep, &mut b[at..at + 8]);
+                blended[3].store_masked(keep, &mut a[at..at + 8]);
                 if state.depth_write {
                     depth.store_masked(keep, &mut rows.depth[at..at + 8]);
                 }
