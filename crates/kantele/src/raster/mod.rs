@@ -197,11 +197,16 @@ fn push_rect(rect: PixelRect, out: &mut BlockCoverage) {
         let mut x0 = rect.x0;
         while x0 < rect.x1 {
             let x1 = ((x0 & !(block - 1)) + block).min(rect.x1);
-            let row = (u64::MAX >> (64 - (x1 - x0))) << (x0 & 7);
-            let mut mask = 0;
-            for y in y0..y1 {
-                mask |= row << ((y & 7) << 3);
-            }
+            let mask = if x1 - x0 == block && y1 - y0 == block {
+                u64::MAX
+            } else {
+                let row = (u64::MAX >> (64 - (x1 - x0))) << (x0 & 7);
+                let mut mask = 0;
+                for y in y0..y1 {
+                    mask |= row << ((y & 7) << 3);
+                }
+                mask
+            };
             out.push(x0, y0, mask);
             x0 = x1;
         }
