@@ -82,6 +82,21 @@ pub struct MaterialShader<'a> {
     ids: (f32, f32),
     /// Emissive texture (see [`MaterialShader::with_emissive_texture`]).
     emissive_texture: Option<(&'a Texture, Sampler)>,
+    /// The material's properties for the lane program of an untextured colour-pass draw,
+    /// decided once per draw (`None` for every other draw).
+    untextured_color: Option<UntexturedColor>,
+}
+
+/// What the lane program of an untextured colour-pass draw reads of its material, copied out
+/// once per draw: the per-row program then branches on the alpha mode and on lit or unlit
+/// only, instead of on every material property, with the same operations in the same order.
+#[derive(Clone, Copy, Debug)]
+struct UntexturedColor {
+    unlit: bool,
+    alpha_mode: AlphaMode,
+    base_color_factor: [f32; 4],
+    emissive: Vec3,
+    double_sided: bool,
 }
 
 impl<'a> MaterialShader<'a> {
@@ -105,14 +120,31 @@ impl<'a> MaterialShader<'a> {
             pass,
             ids: (ids.0 as f32, ids.1 as f32),
             emissive_texture: None,
+            untextured_color: None,
         }
+        .with_lane_program()
+    }
+
+    /// Decides which lane program the draw runs (see [`UntexturedColor`]).
+    fn with_lane_program(mut self) -> Self {
+        let m = self.material;
+        let untextured_color =
+            self.pass == Pass::Color && self.texture.is_none() && self.emissive_texture.is_none();
+        self.untextured_color = untextured_color.then_some(UntexturedColor {
+            unlit: m.unlit,
+            alpha_mode: m.alpha_mode,
+            base_color_factor: m.base_color_factor.to_array(),
+            emissive: m.emissive,
+            double_sided: m.double_sided,
+        });
+        self
     }
 
     /// The same shader reading the material's emissive texture (emission: `material.emissive`
     /// × this texture at the base colour's texture coordinates, added after lighting).
     pub fn with_emissive_texture(mut self, texture: Option<(&'a Texture, Sampler)>) -> Self {
         self.emissive_texture = texture;
-        self
+        self.with_lane_program()
     }
 
     /// The fixed-function state the material asks for: culling unless double-sided, and for
@@ -242,6 +274,9 @@ impl MaterialShader<'_> {
 impl MaterialShader<'_> {
     #[inline(always)]
     fn shade_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+        if let Some(program) = &self.untextured_color {
+            return self.shade_untextured_color_lanes(f, program);
+        }
         let lanes = f.lanes;
         let all = lanes.mask_all(true);
         let needs_alpha = !matches!(self.material.alpha_mode, AlphaMode::Opaque);
@@ -252,14 +287,7 @@ impl MaterialShader<'_> {
             };
         }
         let base = self.base_color_lanes(f);
-        let (alpha, keep) = match self.material.alpha_mode {
-            AlphaMode::Opaque => (lanes.splat_f32(1.0), all),
-            AlphaMode::Mask { cutoff } => (
-                lanes.splat_f32(1.0),
-                base[3].simd_lt(lanes.splat_f32(cutoff)).not(),
-            ),
-            AlphaMode::Blend => (base[3], all),
-        };
+        let (alpha, keep) = Self::alpha_lanes(lanes, self.material.alpha_mode, base[3]);
         if self.pass != Pass::Color {
             return ShadedLanes {
                 color: self.auxiliary_lanes(f),
@@ -278,8 +306,81 @@ impl MaterialShader<'_> {
                 keep,
             };
         }
+        let n = self.normal_lanes(f, self.material.double_sided);
+        let emissive = self.emissive_lanes(f);
+        let [r, g, b] = self.lit_lanes(lanes, n, &base, emissive);
+        ShadedLanes {
+            color: [r, g, b, alpha],
+            keep,
+        }
+    }
+
+    /// [`MaterialShader::shade_lanes`] for an untextured colour-pass draw: the same
+    /// operations in the same order, with the material's properties read from `program`.
+    #[inline(always)]
+    fn shade_untextured_color_lanes<L: Lanes>(
+        &self,
+        f: &FragmentLanes<'_, L>,
+        program: &UntexturedColor,
+    ) -> ShadedLanes<L> {
+        let lanes = f.lanes;
+        let factor = program.base_color_factor;
+        let base = [
+            lanes.splat_f32(factor[0]) * f.varying(5),
+            lanes.splat_f32(factor[1]) * f.varying(6),
+            lanes.splat_f32(factor[2]) * f.varying(7),
+            lanes.splat_f32(factor[3]) * f.varying(8),
+        ];
+        let (alpha, keep) = Self::alpha_lanes(lanes, program.alpha_mode, base[3]);
+        let e = program.emissive;
+        let emissive = [
+            lanes.splat_f32(e.x),
+            lanes.splat_f32(e.y),
+            lanes.splat_f32(e.z),
+        ];
+        if program.unlit {
+            return ShadedLanes {
+                color: [
+                    base[0] + emissive[0],
+                    base[1] + emissive[1],
+                    base[2] + emissive[2],
+                    alpha,
+                ],
+                keep,
+            };
+        }
+        let n = self.normal_lanes(f, program.double_sided);
+        let [r, g, b] = self.lit_lanes(lanes, n, &base, emissive);
+        ShadedLanes {
+            color: [r, g, b, alpha],
+            keep,
+        }
+    }
+
+    /// Alpha and the kept lanes by the alpha mode, from the base colour's alpha.
+    #[inline(always)]
+    fn alpha_lanes<L: Lanes>(lanes: L, mode: AlphaMode, base_alpha: L::F32) -> (L::F32, L::Mask) {
+        let all = lanes.mask_all(true);
+        match mode {
+            AlphaMode::Opaque => (lanes.splat_f32(1.0), all),
+            AlphaMode::Mask { cutoff } => (
+                lanes.splat_f32(1.0),
+                base_alpha.simd_lt(lanes.splat_f32(cutoff)).not(),
+            ),
+            AlphaMode::Blend => (base_alpha, all),
+        }
+    }
+
+    /// Lambert: `base.rgb × (ambient + (1 − ambient) × max(0, N·L) × light) + emissive`.
+    #[inline(always)]
+    fn lit_lanes<L: Lanes>(
+        &self,
+        lanes: L,
+        n: [L::F32; 3],
+        base: &[L::F32; 4],
+        emissive: [L::F32; 3],
+    ) -> [L::F32; 3] {
         let l = self.lighting;
-        let n = self.normal_lanes(f);
         let n_dot_l = (n[0] * lanes.splat_f32(l.to_light.x)
             + n[1] * lanes.splat_f32(l.to_light.y)
             + n[2] * lanes.splat_f32(l.to_light.z))
@@ -291,16 +392,11 @@ impl MaterialShader<'_> {
             ambient + diffuse * lanes.splat_f32(l.light_color.y),
             ambient + diffuse * lanes.splat_f32(l.light_color.z),
         ];
-        let emissive = self.emissive_lanes(f);
-        ShadedLanes {
-            color: [
-                base[0] * light[0] + emissive[0],
-                base[1] * light[1] + emissive[1],
-                base[2] * light[2] + emissive[2],
-                alpha,
-            ],
-            keep,
-        }
+        [
+            base[0] * light[0] + emissive[0],
+            base[1] * light[1] + emissive[1],
+            base[2] * light[2] + emissive[2],
+        ]
     }
 
     /// [`MaterialShader::emissive`] per lane, the texture sampled lane-wide.
@@ -343,9 +439,9 @@ impl MaterialShader<'_> {
     }
 
     /// The interpolated world normal, renormalised (zero when degenerate, as
-    /// `Vec3::normalize_or_zero`), flipped on back faces of double-sided materials.
+    /// `Vec3::normalize_or_zero`), flipped on back faces when `double_sided`.
     #[inline(always)]
-    fn normal_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 3] {
+    fn normal_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>, double_sided: bool) -> [L::F32; 3] {
         let lanes = f.lanes;
         let n = [f.varying(0), f.varying(1), f.varying(2)];
         let length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
@@ -360,7 +456,7 @@ impl MaterialShader<'_> {
             usable.select_f32(n[1] * rcp, zero),
             usable.select_f32(n[2] * rcp, zero),
         ];
-        if self.material.double_sided && !f.front_facing {
+        if double_sided && !f.front_facing {
             [-n[0], -n[1], -n[2]]
         } else {
             n
@@ -373,7 +469,7 @@ impl MaterialShader<'_> {
         let lanes = f.lanes;
         match self.pass {
             Pass::Normals => {
-                let n = self.normal_lanes(f);
+                let n = self.normal_lanes(f, self.material.double_sided);
                 [n[0], n[1], n[2], lanes.splat_f32(1.0)]
             }
             _ => [

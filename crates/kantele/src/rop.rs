@@ -10,7 +10,7 @@ use glam::Vec4;
 pub use crate::state::{BlendMode, DepthFunc};
 
 use crate::error::RenderError;
-use crate::fixed::{BLOCK_LOG2, TILE_LOG2, TILE_PIXELS, TILE_SIZE};
+use crate::fixed::{BLOCK_LOG2, BLOCK_SIZE, TILE_LOG2, TILE_PIXELS, TILE_SIZE};
 use crate::multisample::{SampleCount, MAX_MULTISAMPLE_TARGET_BYTES};
 
 /// 8 × 8 blocks in a tile (64).
@@ -41,6 +41,35 @@ pub struct TileBuffer {
     /// The largest depth of each 8 × 8 block (row-major blocks of the tile), kept exact by the
     /// per-pixel path after every block it writes: the second level of the depth hierarchy.
     block_depth_max: [f32; BLOCKS_PER_TILE],
+}
+
+/// Pixels from the first of an 8 × 8 block to its last, in a tile's row-major order: seven
+/// tile rows and one block row.
+pub const BLOCK_SPAN: usize = (BLOCK_SIZE as usize - 1) * TILE_SIZE as usize + BLOCK_SIZE as usize;
+
+/// The depth and colour (red, green, blue, alpha planes) of one 8 × 8 block of a single-sample
+/// tile, each from the block's first pixel on: block row `r` starts at `r · TILE_SIZE`.
+pub struct BlockRows<'a> {
+    /// Window depths.
+    pub depth: &'a mut [f32; BLOCK_SPAN],
+    /// Linear colour planes.
+    pub color: [&'a mut [f32; BLOCK_SPAN]; 4],
+}
+
+impl BlockRows<'_> {
+    /// Offset of block row `row` (0..8) from the block's first pixel.
+    #[inline(always)]
+    pub fn row_offset(row: usize) -> usize {
+        row * TILE_SIZE as usize
+    }
+}
+
+/// The [`BLOCK_SPAN`] values of `plane` from the block's first pixel `first` on.
+#[inline(always)]
+fn block_span(plane: &mut [f32], first: usize) -> &mut [f32; BLOCK_SPAN] {
+    plane[first..]
+        .first_chunk_mut::<BLOCK_SPAN>()
+        .expect("an 8 x 8 block lies inside its tile")
 }
 
 /// Margin below a triangle's smallest vertex depth. Interpolated depth is clamped to the
@@ -75,6 +104,26 @@ impl TileBuffer {
     #[inline(always)]
     pub fn depth_row_mut(&mut self, index: usize) -> &mut [f32] {
         &mut self.depth[index..]
+    }
+
+    /// The depth and colour rows of the 8 × 8 block whose first pixel has tile index `first`
+    /// (single-sample tiles): fixed-size views, so the per-pixel loop indexes its rows without
+    /// bounds checks.
+    #[inline(always)]
+    pub fn block_rows_mut(&mut self, first: usize) -> BlockRows<'_> {
+        debug_assert_eq!(self.samples, 1);
+        let (r, rest) = self.color.split_at_mut(TILE_PIXELS);
+        let (g, rest) = rest.split_at_mut(TILE_PIXELS);
+        let (b, a) = rest.split_at_mut(TILE_PIXELS);
+        BlockRows {
+            depth: block_span(&mut self.depth, first),
+            color: [
+                block_span(r, first),
+                block_span(g, first),
+                block_span(b, first),
+                block_span(a, first),
+            ],
+        }
     }
 
     /// Samples per pixel of this tile.
@@ -248,22 +297,47 @@ impl TileBuffer {
         if self.depth_bound_exact || area < DEPTH_BOUND_REFRESH_AREA.min(tile_area / 4) {
             return false;
         }
-        // Only pixels on the target: those past its edge keep the clear value forever. Every
-        // depth plane (the pixel centres' and, when multisampled, each sample's).
-        let mut bound = f32::NEG_INFINITY;
-        for plane in self.depth.chunks_exact(TILE_PIXELS) {
-            for y in tile.y0..tile.y1 {
-                let row = Self::index(tile.x0, y);
-                let width = tile.width() as usize;
-                bound = plane[row..row + width]
-                    .iter()
-                    .copied()
-                    .fold(bound, f32::max);
-            }
-        }
-        self.depth_bound = bound;
+        self.depth_bound = self.exact_depth_bound(tile);
         self.depth_bound_exact = true;
         min_depth > self.depth_bound
+    }
+
+    /// The largest depth of the tile's pixels on the target (`tile` is the tile's rectangle on
+    /// it; pixels past its edge keep the clear value forever), over every depth plane (the
+    /// pixel centres' and, when multisampled, each sample's). A block wholly on the target
+    /// gives its exact maximum, kept by the per-pixel paths, so only blocks cut by the
+    /// target's edge are read pixel by pixel: 64 values instead of 4096 for an inner tile.
+    fn exact_depth_bound(&self, tile: &PixelRect) -> f32 {
+        let block = BLOCK_SIZE as i32;
+        let mut bound = f32::NEG_INFINITY;
+        for by in 0..(TILE_SIZE as i32 / block) {
+            let y0 = tile.y0 + by * block;
+            let y1 = (y0 + block).min(tile.y1);
+            if y0 >= y1 {
+                break;
+            }
+            for bx in 0..(TILE_SIZE as i32 / block) {
+                let x0 = tile.x0 + bx * block;
+                let x1 = (x0 + block).min(tile.x1);
+                if x0 >= x1 {
+                    break;
+                }
+                if y1 - y0 == block && x1 - x0 == block {
+                    bound = bound.max(self.block_depth_max[Self::block_index(x0, y0)]);
+                    continue;
+                }
+                for plane in self.depth.chunks_exact(TILE_PIXELS) {
+                    for y in y0..y1 {
+                        let row = Self::index(x0, y);
+                        bound = plane[row..row + (x1 - x0) as usize]
+                            .iter()
+                            .copied()
+                            .fold(bound, f32::max);
+                    }
+                }
+            }
+        }
+        bound
     }
 
     /// Index of absolute pixel `(x, y)` within the tile (the tile's origin is a multiple of

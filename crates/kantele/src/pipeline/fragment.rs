@@ -13,11 +13,11 @@ use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::draw::{DrawCall, DrawJob};
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
-use super::shader::{FragmentLanes, Interpolation, Shader};
+use super::shader::{vertex_varyings, FragmentLanes, Interpolation, Shader};
 use crate::fixed::pixel_center;
 use crate::raster::bin::TileBins;
 use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
-use crate::rop::{Framebuffer, TileBuffer};
+use crate::rop::{BlendMode, BlockRows, Framebuffer, TileBuffer};
 use crate::setup::TriangleSetup;
 use crate::simd::{dispatch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
 
@@ -177,10 +177,31 @@ impl<L: Lanes> TriangleLanes<L> {
     /// (|d| < 2^31), converted to f32 with round-to-nearest-even.
     #[inline(always)]
     pub(super) fn barycentrics(&self, lanes: L, dx: i64, dy: i64) -> [L::F32; 3] {
+        let columns = self.column_terms(lanes, dx);
+        self.barycentrics_in_row(lanes, &columns, dy)
+    }
+
+    /// The x terms `g1.x · dx` and `g2.x · dx` of [`TriangleLanes::barycentrics`] for the eight
+    /// lanes whose first lies `dx` sub-pixel units right of vertex 0: the same for every row of
+    /// a block, so computed once per block.
+    #[inline(always)]
+    pub(super) fn column_terms(&self, lanes: L, dx: i64) -> [L::F32; 2] {
         let dx = (lanes.splat_i32(dx as i32) + self.lane_offset).to_f32();
+        [self.g1[0] * dx, self.g2[0] * dx]
+    }
+
+    /// [`TriangleLanes::barycentrics`] of a row `dy` sub-pixel units below vertex 0, from the
+    /// row's [`TriangleLanes::column_terms`] (the same operations in the same order).
+    #[inline(always)]
+    pub(super) fn barycentrics_in_row(
+        &self,
+        lanes: L,
+        [x1, x2]: &[L::F32; 2],
+        dy: i64,
+    ) -> [L::F32; 3] {
         let dy = lanes.splat_f32(dy as f32);
-        let l1 = self.g1[0] * dx + self.g1[1] * dy;
-        let l2 = self.g2[0] * dx + self.g2[1] * dy;
+        let l1 = *x1 + self.g1[1] * dy;
+        let l2 = *x2 + self.g2[1] * dy;
         [self.one - l1 - l2, l1, l2]
     }
 
@@ -225,8 +246,9 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
         let state = &draw.state;
         let shader = draw.shader;
         let (dl_dx, dl_dy) = tri.barycentric_gradients();
+        let vertex_attrs = vertex_varyings(attrs);
         let interpolation = Interpolation {
-            attrs,
+            attrs: &vertex_attrs,
             varying_count: shader.varying_count(),
             inv_w: tri.inv_w,
             dl_dx,
@@ -237,6 +259,13 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
         let [v0x, v0y] = tri.pos_subpixel[0];
         let mut counters = RasterCounters::default();
         let blocks_can_reject = draw.rejects_by_depth_bound();
+        // Interpolated depth is clamped to the vertex range, so when that range lies in
+        // [0, 1] no lane can fall outside it and the per-row range test is skipped (a NaN
+        // bound fails the comparison and keeps the test).
+        let depth_needs_range_test = !(tri.depth_range[0] >= 0.0 && tri.depth_range[1] <= 1.0);
+        // Replace ignores the stored colour and passes the sanitised source through: nothing
+        // to load, and nothing new to sanitise after blending.
+        let blend_reads_target = state.blend != BlendMode::Replace;
 
         for block in coverage.blocks() {
             // Depth hierarchy, second level: a block whose every stored depth is in front of the
@@ -246,33 +275,37 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 counters.blocks_rejected += 1;
                 continue;
             }
-            let mut wrote_depth = false;
+            counters.covered += block.mask.count_ones() as u64;
+            // Lanes shaded and lanes kept, row by row (bit `8·row + lane`): counted once per
+            // block, not per row.
+            let mut shaded_bits = 0u64;
+            let mut kept_bits = 0u64;
+            let columns = triangle.column_terms(lanes, pixel_center(block.x as i64) - v0x);
+            let mut rows = tile.block_rows_mut(TileBuffer::index(block.x, block.y));
             for row in 0..8 {
                 let row_bits = (block.mask >> (8 * row)) as u8;
                 if row_bits == 0 {
                     continue;
                 }
-                counters.covered += row_bits.count_ones() as u64;
-                let (x, y) = (block.x, block.y + row);
-                let bary = triangle.barycentrics(
-                    lanes,
-                    pixel_center(x as i64) - v0x,
-                    pixel_center(y as i64) - v0y,
-                );
+                let (x, y) = (block.x, block.y + row as i32);
+                let at = BlockRows::row_offset(row);
+                let bary =
+                    triangle.barycentrics_in_row(lanes, &columns, pixel_center(y as i64) - v0y);
                 let depth = triangle.depth(bary);
-                // Outside [0, 1] (or NaN): beyond the near or far plane.
-                let mut active = lanes
-                    .mask_from_bits(row_bits)
-                    .and(depth.simd_ge(zero))
-                    .and(depth.simd_le(one));
-                let index = TileBuffer::index(x, y);
+                let mut active = lanes.mask_from_bits(row_bits);
+                if depth_needs_range_test {
+                    // Outside [0, 1] (or NaN): beyond the near or far plane.
+                    active = active.and(depth.simd_ge(zero)).and(depth.simd_le(one));
+                }
                 if state.depth_test {
-                    let stored = lanes.load_f32(tile.depth_row(index));
+                    let stored = lanes.load_f32(&rows.depth[at..at + 8]);
                     active = active.and(state.depth_func.passes_lanes(lanes, depth, stored));
                 }
-                if active.none() {
+                let active_bits = active.bits();
+                if active_bits == 0 {
                     continue;
                 }
+                shaded_bits |= (active_bits as u64) << (8 * row);
                 let (weights, w) = triangle.perspective_weights(bary);
                 let fragments = FragmentLanes {
                     lanes,
@@ -288,43 +321,47 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 };
                 let shaded = shader.fragment_lanes(&fragments);
                 let keep = active.and(shaded.keep);
-                let active_count = active.count() as u64;
-                let kept = keep.count() as u64;
-                counters.shaded += active_count;
-                counters.discarded += active_count - kept;
-                if kept == 0 {
+                let keep_bits = keep.bits();
+                if keep_bits == 0 {
                     continue;
                 }
-                let [r, g, b, a] = tile.color_row(index);
-                let dst = [
-                    lanes.load_f32(r),
-                    lanes.load_f32(g),
-                    lanes.load_f32(b),
-                    lanes.load_f32(a),
-                ];
+                kept_bits |= (keep_bits as u64) << (8 * row);
                 // NaN channels are written as 0 and counted, before and after blending
                 // (blending infinities can make NaN) (robust branch).
                 let (src, nan_src) = zero_nan_channels(lanes, shaded.color, keep);
-                let blended = state.blend.blend_lanes(lanes, src, dst);
-                let (blended, nan_blended) = zero_nan_channels(lanes, blended, keep);
-                counters.nan_channels += nan_src + nan_blended;
-                let [r, g, b, a] = tile.color_row_mut(index);
-                blended[0].store_masked(keep, r);
-                blended[1].store_masked(keep, g);
-                blended[2].store_masked(keep, b);
-                blended[3].store_masked(keep, a);
+                counters.nan_channels += nan_src;
+                let blended = if blend_reads_target {
+                    let dst = [
+                        lanes.load_f32(&rows.color[0][at..at + 8]),
+                        lanes.load_f32(&rows.color[1][at..at + 8]),
+                        lanes.load_f32(&rows.color[2][at..at + 8]),
+                        lanes.load_f32(&rows.color[3][at..at + 8]),
+                    ];
+                    let blended = state.blend.blend_lanes(lanes, src, dst);
+                    let (blended, nan_blended) = zero_nan_channels(lanes, blended, keep);
+                    counters.nan_channels += nan_blended;
+                    blended
+                } else {
+                    src
+                };
+                let [r, g, b, a] = &mut rows.color;
+                blended[0].store_masked(keep, &mut r[at..at + 8]);
+                blended[1].store_masked(keep, &mut g[at..at + 8]);
+                blended[2].store_masked(keep, &mut b[at..at + 8]);
+                blended[3].store_masked(keep, &mut a[at..at + 8]);
                 if state.depth_write {
-                    depth.store_masked(keep, tile.depth_row_mut(index));
-                    wrote_depth = true;
+                    depth.store_masked(keep, &mut rows.depth[at..at + 8]);
                 }
             }
-            if wrote_depth {
+            let shaded_count = shaded_bits.count_ones() as u64;
+            counters.shaded += shaded_count;
+            counters.discarded += shaded_count - kept_bits.count_ones() as u64;
+            if state.depth_write && kept_bits != 0 {
                 // Keep the block's bound exact: the largest of its 64 depths.
-                let first = TileBuffer::index(block.x, block.y);
-                let row_stride = crate::fixed::TILE_SIZE as usize;
-                let mut largest = lanes.load_f32(tile.depth_row(first));
+                let mut largest = lanes.load_f32(&rows.depth[..8]);
                 for row in 1..8 {
-                    largest = largest.max(lanes.load_f32(tile.depth_row(first + row * row_stride)));
+                    let at = BlockRows::row_offset(row);
+                    largest = largest.max(lanes.load_f32(&rows.depth[at..at + 8]));
                 }
                 tile.set_block_depth_max(block_index, largest.reduce_max());
             }

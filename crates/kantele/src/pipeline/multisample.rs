@@ -22,7 +22,7 @@ use super::draw::{DrawCall, DrawJob};
 use super::fragment::{RasterCounters, TriangleLanes};
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
-use super::shader::{FragmentLanes, Interpolation, Shader};
+use super::shader::{vertex_varyings, FragmentLanes, Interpolation, Shader};
 use crate::fixed::{pixel_center, BLOCK_SIZE, TILE_SIZE};
 use crate::raster::bin::TileBins;
 use crate::raster::samples::{rasterize_samples, SampleCoverage, MAX_COVERAGE_PLANES};
@@ -126,8 +126,9 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
         let state = &draw.state;
         let shader = draw.shader;
         let (dl_dx, dl_dy) = tri.barycentric_gradients();
+        let vertex_attrs = vertex_varyings(attrs);
         let interpolation = Interpolation {
-            attrs,
+            attrs: &vertex_attrs,
             varying_count: shader.varying_count(),
             inv_w: tri.inv_w,
             dl_dx,

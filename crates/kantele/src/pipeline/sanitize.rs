@@ -11,6 +11,16 @@ pub(super) fn zero_nan_channels<L: Lanes>(
     color: [L::F32; 4],
     keep: L::Mask,
 ) -> ([L::F32; 4], u64) {
+    // The common case first: no NaN in a kept lane leaves the colour as it is (the selects
+    // below would change nothing), at one compare per channel and one mask test.
+    let mut any_nan = lanes.mask_all(false);
+    for channel in &color {
+        let c = *channel;
+        any_nan = any_nan.or(c.simd_ne(c));
+    }
+    if any_nan.and(keep).none() {
+        return (color, 0);
+    }
     let zero = lanes.splat_f32(0.0);
     let mut count = 0u64;
     let mut sanitized = color;

@@ -168,11 +168,25 @@ impl Fragment<'_> {
     }
 }
 
+/// The varyings of a triangle's three (oriented) vertices, vertex-major, in an array of fixed
+/// size (entries past `3 × varying_count` are 0): a shader's constant indices into it need no
+/// bounds check in the per-pixel loop.
+pub(crate) type VertexVaryings = [f32; 3 * MAX_VARYINGS];
+
+/// `attrs` (at most `3 × MAX_VARYINGS` values) as [`VertexVaryings`].
+#[inline(always)]
+pub(crate) fn vertex_varyings(attrs: &[f32]) -> VertexVaryings {
+    let mut out = [0.0; 3 * MAX_VARYINGS];
+    let n = attrs.len().min(out.len());
+    out[..n].copy_from_slice(&attrs[..n]);
+    out
+}
+
 /// Per-triangle data for interpolation and derivatives, shared by [`Fragment`] and
 /// [`FragmentLanes`] so that both evaluate the same formulas.
 pub(crate) struct Interpolation<'a> {
     /// Varyings of the three (oriented) vertices, vertex-major.
-    pub(crate) attrs: &'a [f32],
+    pub(crate) attrs: &'a VertexVaryings,
     pub(crate) varying_count: usize,
     pub(crate) inv_w: [f32; 3],
     pub(crate) dl_dx: [f32; 3],

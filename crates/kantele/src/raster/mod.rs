@@ -141,24 +141,76 @@ pub fn rasterize_blocks(
             && rect.y0 >> TILE_LOG2 == (rect.y1 - 1) >> TILE_LOG2,
         "rectangle spans more than one tile"
     );
+    let uses_blocks = match strategy {
+        Strategy::BoundingBox | Strategy::Incremental => false,
+        Strategy::Block => true,
+        Strategy::Adaptive | Strategy::Bisector => prefers_blocks(tri),
+    };
+    // The block strategies first try the whole rectangle: when it lies inside the triangle
+    // (a full-screen quad in most of its tiles), every pixel is covered and no block is
+    // classified or scanned.
+    if uses_blocks && rect_inside(tri, &rect) {
+        push_rect(rect, out);
+        return;
+    }
     match strategy {
         Strategy::BoundingBox => scan_bounding_box(tri, rect, out),
         Strategy::Incremental => scan_incremental(tri, rect, out),
         Strategy::Block => scan_blocks(tri, rect, out),
         Strategy::Adaptive => {
-            if prefers_blocks(tri) {
+            if uses_blocks {
                 scan_blocks(tri, rect, out)
             } else {
                 scan_incremental(tri, rect, out)
             }
         }
         Strategy::Bisector => {
-            if prefers_blocks(tri) {
+            if uses_blocks {
                 scan_bisector(tri, rect, out)
             } else {
                 scan_incremental(tri, rect, out)
             }
         }
+    }
+}
+
+/// Whether the centre of every pixel of `rect` (non-empty) is covered: edge functions are
+/// linear, so a rectangle whose four corner pixels are inside an edge is wholly inside it.
+#[inline]
+fn rect_inside(tri: &TriangleSetup, rect: &PixelRect) -> bool {
+    let (x1, y1) = (rect.x1 - 1, rect.y1 - 1);
+    tri.edges.iter().all(|e| {
+        e.biased_at_pixel(rect.x0, rect.y0) >= 0
+            && e.biased_at_pixel(x1, rect.y0) >= 0
+            && e.biased_at_pixel(rect.x0, y1) >= 0
+            && e.biased_at_pixel(x1, y1) >= 0
+    })
+}
+
+/// Appends every pixel of `rect` (non-empty, within one tile) as covered, block by block in
+/// row-major order.
+fn push_rect(rect: PixelRect, out: &mut BlockCoverage) {
+    let block = BLOCK_SIZE as i32;
+    let mut y0 = rect.y0;
+    while y0 < rect.y1 {
+        let y1 = ((y0 & !(block - 1)) + block).min(rect.y1);
+        let mut x0 = rect.x0;
+        while x0 < rect.x1 {
+            let x1 = ((x0 & !(block - 1)) + block).min(rect.x1);
+            let mask = if x1 - x0 == block && y1 - y0 == block {
+                u64::MAX
+            } else {
+                let row = (u64::MAX >> (64 - (x1 - x0))) << (x0 & 7);
+                let mut mask = 0;
+                for y in y0..y1 {
+                    mask |= row << ((y & 7) << 3);
+                }
+                mask
+            };
+            out.push(x0, y0, mask);
+            x0 = x1;
+        }
+        y0 = y1;
     }
 }
 
@@ -583,6 +635,54 @@ mod tests {
             checked += 1;
         }
         assert!(checked > 300);
+    }
+
+    #[test]
+    fn wholly_covered_tiles_give_every_pixel_once() {
+        // A triangle far larger than the 150 × 100 target: every tile (whole or cut by the
+        // target's edge, at any alignment of the rectangle) is inside it.
+        let vp = Viewport::new(150, 100);
+        let tri = setup_triangle(
+            &vp,
+            [
+                Vec4::new(-3.0, -3.0, 0.0, 1.0),
+                Vec4::new(5.0, -3.0, 0.0, 1.0),
+                Vec4::new(-3.0, 5.0, 0.0, 1.0),
+            ],
+            CullMode::None,
+            FrontFace::Ccw,
+        )
+        .expect("valid");
+        for rect in [
+            PixelRect {
+                x0: 0,
+                y0: 0,
+                x1: 64,
+                y1: 64,
+            },
+            PixelRect {
+                x0: 128,
+                y0: 64,
+                x1: 150,
+                y1: 100,
+            },
+            PixelRect {
+                x0: 67,
+                y0: 3,
+                x1: 125,
+                y1: 61,
+            },
+        ] {
+            let expected: Vec<(i32, i32)> = (rect.x0..rect.x1)
+                .flat_map(|x| (rect.y0..rect.y1).map(move |y| (x, y)))
+                .collect();
+            for s in Strategy::ALL {
+                assert_eq!(coverage(&tri, rect, s), expected, "{s} on {rect:?}");
+            }
+            let mut blocks = BlockCoverage::default();
+            rasterize_blocks(&tri, rect, Strategy::Bisector, &mut blocks);
+            assert_eq!(blocks.pixel_count(), expected.len() as u64);
+        }
     }
 
     #[test]

@@ -18,10 +18,11 @@ pub struct Avx2 {
 }
 
 impl Avx2 {
-    /// The token, if this CPU supports AVX2 (runtime detection, cached by `std`).
+    /// The token, if this CPU supports AVX2 and `popcnt` (runtime detection, cached by `std`;
+    /// every AVX2 CPU has `popcnt`, which kernels use to count mask bits).
     #[inline(always)]
     pub fn new() -> Option<Avx2> {
-        if is_x86_feature_detected!("avx2") {
+        if is_x86_feature_detected!("avx2") && is_x86_feature_detected!("popcnt") {
             Some(Avx2 { _detected: () })
         } else {
             None
@@ -33,11 +34,11 @@ impl Avx2 {
 /// are inlined into this `#[target_feature]` function.
 #[inline]
 pub(super) fn run<K: LaneKernel>(token: Avx2, kernel: K) -> K::Output {
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,popcnt")]
     unsafe fn run_avx2<K: LaneKernel>(token: Avx2, kernel: K) -> K::Output {
         kernel.run(token)
     }
-    // SAFETY: `token` exists, so AVX2 was detected on this CPU.
+    // SAFETY: `token` exists, so AVX2 and `popcnt` were detected on this CPU.
     unsafe { run_avx2(token, kernel) }
 }
 
