@@ -17,6 +17,8 @@ mod errors;
 mod info_bench;
 mod render;
 mod shared_scenes;
+// The viewer is an optional feature; the lean build has no `view` command to test.
+#[cfg(feature = "viewer")]
 mod view;
 
 use common::{stderr, TempDir};

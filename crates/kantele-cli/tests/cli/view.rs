@@ -1,18 +1,17 @@
-//! `kantele view` under a virtual display.
+//! `kantele view` under a virtual display (compiled with the `viewer` feature only; see
+//! `main.rs`).
 
 use std::process::Command;
 
 use crate::common::{ok, TempDir, BIN};
 use crate::distinct_colors;
 
-#[cfg(feature = "viewer")]
 fn on_path(program: &str) -> bool {
     std::env::var_os("PATH")
         .map(|p| std::env::split_paths(&p).any(|d| d.join(program).is_file()))
         .unwrap_or(false)
 }
 
-#[cfg(feature = "viewer")]
 #[test]
 fn viewer_under_xvfb() {
     if !on_path("xvfb-run") {
