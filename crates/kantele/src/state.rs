@@ -231,7 +231,7 @@ impl Default for RenderState {
 
 /// How the ids pass encodes a pixel's ids (the same in every backend): the colour is
 /// `(instance, primitive, draw, 1)`, each id as an exact `f32` integer, and 0 means background
-/// (nothing drawn). Ids are stored in `f32`, so they are exact up to [`MAX_EXACT_ID`].
+/// (nothing drawn). Ids are stored in `f32`, so they are exact up to [`ids::MAX_EXACT_ID`].
 pub mod ids {
     /// Largest id an `f32` channel holds exactly (2^24).
     pub const MAX_EXACT_ID: u32 = 1 << 24;
