@@ -10,7 +10,9 @@ impl Loader<'_> {
     pub(super) fn camera(&mut self, node: &gltf::Node, world: Mat4) -> Option<Camera> {
         let camera = node.camera()?;
         let name = named(camera.name(), "camera", camera.index());
-        match camera.projection() {
+        let view = world.inverse();
+        // The projection's parameters, if valid (the view matrix is checked below for both).
+        let projected = match camera.projection() {
             gltf::camera::Projection::Perspective(p) => {
                 let ok = p.yfov().is_finite()
                     && p.yfov() > 0.0
@@ -19,14 +21,7 @@ impl Loader<'_> {
                     && p.znear() > 0.0
                     && p.zfar().is_none_or(|f| f.is_finite() && f > p.znear())
                     && p.aspect_ratio().is_none_or(|a| a.is_finite() && a > 0.0);
-                let view = world.inverse();
-                if !ok || !view.is_finite() {
-                    self.info.warn(format!(
-                        "camera '{name}' has invalid parameters or placement; ignored"
-                    ));
-                    return None;
-                }
-                Some(Camera {
+                ok.then(|| Camera {
                     view,
                     yfov: p.yfov(),
                     ymag: None,
@@ -47,14 +42,7 @@ impl Loader<'_> {
                     && o.znear() >= 0.0
                     && o.zfar().is_finite()
                     && o.zfar() > o.znear();
-                let view = world.inverse();
-                if !ok || !view.is_finite() {
-                    self.info.warn(format!(
-                        "camera '{name}' has invalid parameters or placement; ignored"
-                    ));
-                    return None;
-                }
-                Some(Camera {
+                ok.then(|| Camera {
                     view,
                     yfov: std::f32::consts::FRAC_PI_4,
                     ymag: Some(ymag),
@@ -64,6 +52,15 @@ impl Loader<'_> {
                     znear: o.znear().max(o.zfar() * 1e-6),
                     zfar: Some(o.zfar()),
                 })
+            }
+        };
+        match projected {
+            Some(camera) if view.is_finite() => Some(camera),
+            _ => {
+                self.info.warn(format!(
+                    "camera '{name}' has invalid parameters or placement; ignored"
+                ));
+                None
             }
         }
     }
