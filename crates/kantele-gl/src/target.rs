@@ -29,6 +29,42 @@ pub(crate) struct MultisampleTarget {
     pub(crate) samples: SampleCount,
 }
 
+/// Depth format of both framebuffers.
+const DEPTH_FORMAT: u32 = glow::DEPTH_COMPONENT32F;
+
+/// Allocates `renderbuffer` as `width × height` of `format` with `samples` per pixel and attaches
+/// it to the bound framebuffer at `attachment` (the renderbuffer binding is left unbound).
+///
+/// # Safety
+/// `gl` must be current on this thread, with a framebuffer bound that owns `renderbuffer`.
+unsafe fn attach_renderbuffer(
+    gl: &glow::Context,
+    renderbuffer: glow::Renderbuffer,
+    attachment: u32,
+    format: u32,
+    samples: SampleCount,
+    (width, height): (i32, i32),
+) {
+    // SAFETY: the caller guarantees a current context and a bound framebuffer; `renderbuffer`
+    // is a live object of that context.
+    unsafe {
+        gl.bind_renderbuffer(glow::RENDERBUFFER, Some(renderbuffer));
+        if samples.is_multisampled() {
+            let count = samples.count() as i32;
+            gl.renderbuffer_storage_multisample(glow::RENDERBUFFER, count, format, width, height);
+        } else {
+            gl.renderbuffer_storage(glow::RENDERBUFFER, format, width, height);
+        }
+        gl.framebuffer_renderbuffer(
+            glow::FRAMEBUFFER,
+            attachment,
+            glow::RENDERBUFFER,
+            Some(renderbuffer),
+        );
+        gl.bind_renderbuffer(glow::RENDERBUFFER, None);
+    }
+}
+
 impl GlBackend {
     /// Creates (or re-creates) the framebuffer for the view's size, the selected format and
     /// `samples` per pixel.
@@ -70,34 +106,25 @@ impl GlBackend {
             let color = gl.create_renderbuffer().map_err(backend_error)?;
             let depth = gl.create_renderbuffer().map_err(backend_error)?;
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
-            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(color));
             let color_format = if fast { glow::RGBA8 } else { glow::RGBA32F };
-            gl.renderbuffer_storage(
-                glow::RENDERBUFFER,
-                color_format,
-                width as i32,
-                height as i32,
-            );
-            gl.framebuffer_renderbuffer(
-                glow::FRAMEBUFFER,
+            let size = (width as i32, height as i32);
+            let single = SampleCount::X1;
+            attach_renderbuffer(
+                gl,
+                color,
                 glow::COLOR_ATTACHMENT0,
-                glow::RENDERBUFFER,
-                Some(color),
+                color_format,
+                single,
+                size,
             );
-            gl.bind_renderbuffer(glow::RENDERBUFFER, Some(depth));
-            gl.renderbuffer_storage(
-                glow::RENDERBUFFER,
-                glow::DEPTH_COMPONENT32F,
-                width as i32,
-                height as i32,
-            );
-            gl.framebuffer_renderbuffer(
-                glow::FRAMEBUFFER,
+            attach_renderbuffer(
+                gl,
+                depth,
                 glow::DEPTH_ATTACHMENT,
-                glow::RENDERBUFFER,
-                Some(depth),
+                DEPTH_FORMAT,
+                single,
+                size,
             );
-            gl.bind_renderbuffer(glow::RENDERBUFFER, None);
             let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
             let mut target = Target {
                 framebuffer,
@@ -122,37 +149,23 @@ impl GlBackend {
                     depth: gl.create_renderbuffer().map_err(backend_error)?,
                     samples,
                 };
-                let n = samples.count() as i32;
                 gl.bind_framebuffer(glow::FRAMEBUFFER, Some(ms.framebuffer));
-                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(ms.color));
-                gl.renderbuffer_storage_multisample(
-                    glow::RENDERBUFFER,
-                    n,
-                    color_format,
-                    width as i32,
-                    height as i32,
-                );
-                gl.framebuffer_renderbuffer(
-                    glow::FRAMEBUFFER,
+                attach_renderbuffer(
+                    gl,
+                    ms.color,
                     glow::COLOR_ATTACHMENT0,
-                    glow::RENDERBUFFER,
-                    Some(ms.color),
+                    color_format,
+                    samples,
+                    size,
                 );
-                gl.bind_renderbuffer(glow::RENDERBUFFER, Some(ms.depth));
-                gl.renderbuffer_storage_multisample(
-                    glow::RENDERBUFFER,
-                    n,
-                    glow::DEPTH_COMPONENT32F,
-                    width as i32,
-                    height as i32,
-                );
-                gl.framebuffer_renderbuffer(
-                    glow::FRAMEBUFFER,
+                attach_renderbuffer(
+                    gl,
+                    ms.depth,
                     glow::DEPTH_ATTACHMENT,
-                    glow::RENDERBUFFER,
-                    Some(ms.depth),
+                    DEPTH_FORMAT,
+                    samples,
+                    size,
                 );
-                gl.bind_renderbuffer(glow::RENDERBUFFER, None);
                 let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
                 target.multisample = Some(ms);
                 if status != glow::FRAMEBUFFER_COMPLETE {
