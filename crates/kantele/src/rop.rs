@@ -41,6 +41,19 @@ pub struct TileBuffer {
     /// The largest depth of each 8 × 8 block (row-major blocks of the tile), kept exact by the
     /// per-pixel path after every block it writes: the second level of the depth hierarchy.
     block_depth_max: [f32; BLOCKS_PER_TILE],
+    /// A clear not yet written to the storage: while set, every pixel and sample of the tile
+    /// holds this colour and depth, whatever `color` and `depth` contain. Clearing a frame only
+    /// sets it; the first triangle that reaches the tile writes it out
+    /// ([`TileBuffer::materialize`]), in the thread that rasterizes the tile, so the tile is
+    /// in cache for its triangles, and a tile that no triangle reaches is never written.
+    deferred_clear: Option<DeferredClear>,
+}
+
+/// The values of a clear that a tile has not written to its storage yet.
+#[derive(Clone, Copy, Debug)]
+struct DeferredClear {
+    color: Vec4,
+    depth: f32,
 }
 
 /// Pixels from the first of an 8 × 8 block to its last, in a tile's row-major order: seven
@@ -90,12 +103,17 @@ impl TileBuffer {
             depth_bound: 1.0,
             depth_bound_exact: true,
             block_depth_max: [1.0; BLOCKS_PER_TILE],
+            deferred_clear: None,
         })
     }
 
     /// Depths of the row starting at tile index `index` (to the end of the tile).
     #[inline(always)]
     pub fn depth_row(&self, index: usize) -> &[f32] {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage read before materialize"
+        );
         &self.depth[index..]
     }
 
@@ -103,6 +121,10 @@ impl TileBuffer {
     /// [`TileBuffer::note_depth_written`] after writing.
     #[inline(always)]
     pub fn depth_row_mut(&mut self, index: usize) -> &mut [f32] {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage read before materialize"
+        );
         &mut self.depth[index..]
     }
 
@@ -111,6 +133,10 @@ impl TileBuffer {
     /// bounds checks.
     #[inline(always)]
     pub fn block_rows_mut(&mut self, first: usize) -> BlockRows<'_> {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage read before materialize"
+        );
         debug_assert_eq!(self.samples, 1);
         let (r, rest) = self.color.split_at_mut(TILE_PIXELS);
         let (g, rest) = rest.split_at_mut(TILE_PIXELS);
@@ -135,6 +161,10 @@ impl TileBuffer {
     /// Depths of sample `sample` from tile index `index` on (multisampled tiles only).
     #[inline(always)]
     pub fn sample_depth_row(&self, sample: usize, index: usize) -> &[f32] {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage read before materialize"
+        );
         debug_assert!(self.samples > 1 && sample < self.samples);
         &self.depth[(1 + sample) * TILE_PIXELS + index..]
     }
@@ -142,6 +172,10 @@ impl TileBuffer {
     /// Mutable depths of sample `sample` from tile index `index` on (multisampled tiles only).
     #[inline(always)]
     pub fn sample_depth_row_mut(&mut self, sample: usize, index: usize) -> &mut [f32] {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage read before materialize"
+        );
         debug_assert!(self.samples > 1 && sample < self.samples);
         &mut self.depth[(1 + sample) * TILE_PIXELS + index..]
     }
@@ -150,6 +184,10 @@ impl TileBuffer {
     /// `index` on.
     #[inline(always)]
     pub fn depth_plane_row(&self, plane: usize, index: usize) -> &[f32] {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage read before materialize"
+        );
         &self.depth[plane * TILE_PIXELS + index..]
     }
 
@@ -162,6 +200,10 @@ impl TileBuffer {
     /// The four colour planes of sample `sample` from tile index `index` on.
     #[inline(always)]
     pub fn sample_color_row(&self, sample: usize, index: usize) -> [&[f32]; 4] {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage read before materialize"
+        );
         let plane = self.samples * TILE_PIXELS;
         let at = sample * TILE_PIXELS + index;
         [
@@ -175,6 +217,10 @@ impl TileBuffer {
     /// The four colour planes of sample `sample` from tile index `index` on, mutable.
     #[inline(always)]
     pub fn sample_color_row_mut(&mut self, sample: usize, index: usize) -> [&mut [f32]; 4] {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage read before materialize"
+        );
         let plane = self.samples * TILE_PIXELS;
         let at = sample * TILE_PIXELS + index;
         let (r, rest) = self.color.split_at_mut(plane);
@@ -186,6 +232,10 @@ impl TileBuffer {
     /// The four colour planes from tile index `index` on (single-sample tiles).
     #[inline(always)]
     pub fn color_row(&self, index: usize) -> [&[f32]; 4] {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage read before materialize"
+        );
         debug_assert_eq!(self.samples, 1);
         let (r, rest) = self.color.split_at(TILE_PIXELS);
         let (g, rest) = rest.split_at(TILE_PIXELS);
@@ -196,6 +246,10 @@ impl TileBuffer {
     /// The four colour planes from tile index `index` on, mutable (single-sample tiles).
     #[inline(always)]
     pub fn color_row_mut(&mut self, index: usize) -> [&mut [f32]; 4] {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage read before materialize"
+        );
         debug_assert_eq!(self.samples, 1);
         let (r, rest) = self.color.split_at_mut(TILE_PIXELS);
         let (g, rest) = rest.split_at_mut(TILE_PIXELS);
@@ -212,6 +266,9 @@ impl TileBuffer {
     /// colour: the mean of its samples in linear space (summed in sample order).
     #[inline]
     pub fn color_at(&self, index: usize) -> Vec4 {
+        if let Some(clear) = self.deferred_clear {
+            return self.resolved_clear_color(clear.color);
+        }
         if self.samples > 1 {
             let plane = self.samples * TILE_PIXELS;
             let mut sum = [0.0f32; 4];
@@ -233,7 +290,43 @@ impl TileBuffer {
     /// The depth of the pixel at tile index `index`.
     #[inline]
     pub fn depth_at(&self, index: usize) -> f32 {
-        self.depth[index]
+        match self.deferred_clear {
+            Some(clear) => clear.depth,
+            None => self.depth[index],
+        }
+    }
+
+    /// What [`TileBuffer::color_at`] gives for a pixel whose every sample holds `color`: the
+    /// same sum in sample order and the same division, so a deferred clear reads back bit for
+    /// bit as a written one.
+    fn resolved_clear_color(&self, color: Vec4) -> Vec4 {
+        if self.samples == 1 {
+            return color;
+        }
+        let mut sum = [0.0f32; 4];
+        for (total, value) in sum.iter_mut().zip(color.to_array()) {
+            for _ in 0..self.samples {
+                *total += value;
+            }
+        }
+        Vec4::from_array(sum) / self.samples as f32
+    }
+
+    /// Writes a deferred clear to the storage (nothing when none is pending). The per-pixel
+    /// paths call it before they touch the tile's colour or depth.
+    #[inline]
+    pub(crate) fn materialize(&mut self) {
+        if let Some(clear) = self.deferred_clear.take() {
+            let plane = self.samples * TILE_PIXELS;
+            for (planes, value) in self
+                .color
+                .chunks_exact_mut(plane)
+                .zip(clear.color.to_array())
+            {
+                planes.fill(value);
+            }
+            self.depth.fill(clear.depth);
+        }
     }
 
     /// Index of the 8 × 8 block holding absolute pixel `(x, y)` within its tile.
@@ -266,8 +359,17 @@ impl TileBuffer {
         self.depth_bound_exact = false;
     }
 
-    /// Fills colour and/or depth.
+    /// Fills colour and/or depth. Clearing both is deferred ([`TileBuffer::materialize`]);
+    /// clearing one of them writes a pending clear first, then that one.
     fn fill(&mut self, color: Option<Vec4>, depth: Option<f32>) {
+        if let (Some(color), Some(depth)) = (color, depth) {
+            self.deferred_clear = Some(DeferredClear { color, depth });
+            self.depth_bound = depth;
+            self.depth_bound_exact = true;
+            self.block_depth_max = [depth; BLOCKS_PER_TILE];
+            return;
+        }
+        self.materialize();
         if let Some(c) = color {
             let plane = self.samples * TILE_PIXELS;
             for (planes, value) in self.color.chunks_exact_mut(plane).zip(c.to_array()) {
@@ -308,6 +410,9 @@ impl TileBuffer {
     /// gives its exact maximum, kept by the per-pixel paths, so only blocks cut by the
     /// target's edge are read pixel by pixel: 64 values instead of 4096 for an inner tile.
     fn exact_depth_bound(&self, tile: &PixelRect) -> f32 {
+        if let Some(clear) = self.deferred_clear {
+            return clear.depth;
+        }
         let block = BLOCK_SIZE as i32;
         let mut bound = f32::NEG_INFINITY;
         for by in 0..(TILE_SIZE as i32 / block) {
@@ -548,7 +653,7 @@ impl Framebuffer {
     /// row 0 = top (on a multisampled target the depth at the pixel centres, equal to a 1×
     /// render's). Needs one row of memory.
     pub fn read_depth_rows(&self, emit: impl FnMut(u32, &[f32])) {
-        self.read_rows(1, |t, i, out| out[0] = t.depth[i], emit);
+        self.read_rows(1, |t, i, out| out[0] = t.depth_at(i), emit);
     }
 
     /// Bytes a whole-frame readback of `bytes_per_pixel` per pixel takes for this target.
@@ -630,7 +735,7 @@ impl Framebuffer {
 
     /// Depth of one pixel (`None` outside the target).
     pub fn depth_at(&self, x: u32, y: u32) -> Option<f32> {
-        self.locate(x, y).map(|(tile, i)| tile.depth[i])
+        self.locate(x, y).map(|(tile, i)| tile.depth_at(i))
     }
 }
 
@@ -689,5 +794,39 @@ mod tests {
         assert!(c.iter().all(|p| *p == [1.0; 4]));
         assert_eq!(fb.read_depth()[209], 0.25);
         assert_eq!(fb.read_rgba8(true).len(), 840);
+    }
+
+    /// A cleared tile that no triangle reached reads back exactly as one whose clear was
+    /// written out, at 1× and multisampled (the resolved mean of equal samples).
+    #[test]
+    fn deferred_clear_reads_back_as_a_written_one() {
+        for samples in [SampleCount::X1, SampleCount::X4, SampleCount::X8] {
+            let mut fb = Framebuffer::new(70, 3, samples).expect("small target");
+            let color = Vec4::new(0.1, 0.7, 1.0 / 3.0, 0.9);
+            fb.clear(Some(color), Some(0.375));
+            let deferred = (fb.read_color(), fb.read_depth());
+            for tile in fb.tiles_mut() {
+                tile.materialize();
+            }
+            let written = (fb.read_color(), fb.read_depth());
+            assert_eq!(deferred, written, "{samples}");
+            assert!(written.1.iter().all(|&d| d == 0.375));
+            assert_eq!(fb.depth_at(69, 2), Some(0.375));
+        }
+    }
+
+    /// Clearing only colour or only depth keeps the other from the clear before it, deferred
+    /// or not.
+    #[test]
+    fn partial_clear_after_a_deferred_one_keeps_the_other_values() {
+        let mut fb = Framebuffer::new(70, 3, SampleCount::X1).expect("small target");
+        fb.clear(Some(Vec4::ONE), Some(0.25));
+        fb.clear(Some(Vec4::ZERO), None);
+        assert!(fb.read_color().iter().all(|p| *p == [0.0; 4]));
+        assert!(fb.read_depth().iter().all(|&d| d == 0.25));
+        fb.clear(Some(Vec4::ONE), Some(0.5));
+        fb.clear(None, Some(0.75));
+        assert!(fb.read_color().iter().all(|p| *p == [1.0; 4]));
+        assert!(fb.read_depth().iter().all(|&d| d == 0.75));
     }
 }

@@ -97,6 +97,7 @@ pub(super) fn raster_tiles(
                     continue;
                 }
                 let attrs = geometry.attrs(t);
+                tile.materialize();
                 let c = draw.raster(tri, attrs, &coverage, tile, isa);
                 counters = RasterCounters::sum(counters, c);
             }

@@ -72,6 +72,7 @@ pub(super) fn raster_tiles_multisampled(
                     continue;
                 }
                 let attrs = geometry.attrs(t);
+                tile.materialize();
                 let c = draw.raster_multisampled(tri, attrs, &coverage, tile, isa);
                 counters = RasterCounters::sum(counters, c);
             }
