@@ -58,15 +58,21 @@ impl Texture {
         if live.none() {
             return [zero; 4];
         }
+        // The sRGB table, looked up once per call rather than once per texel (a `OnceLock`).
+        let srgb = match self.color_space {
+            ColorSpace::Srgb => Some(decode_table(ColorSpace::Srgb)),
+            ColorSpace::Linear => None,
+        };
         let lod = self.lod_lanes::<L>(duv_dx, duv_dy);
         let selection = LevelSelection::<L>::new(self, sampler, lod);
         let nearest = selection.nearest;
-        let first = self.sample_level_lanes::<L>(sampler, selection.first, uv, nearest, live);
+        let first = self.sample_level_lanes::<L>(sampler, srgb, selection.first, uv, nearest, live);
         // The second level only where some live lane blends (trilinear between levels).
         let blend = selection.fraction.simd_gt(zero).and(live);
         let mut texel = first;
         if blend.any() {
-            let second = self.sample_level_lanes::<L>(sampler, selection.second, uv, nearest, live);
+            let second =
+                self.sample_level_lanes::<L>(sampler, srgb, selection.second, uv, nearest, live);
             // A lane with fraction 0 keeps `first` exactly: a·1 + b·0 = a for finite b ≥ 0.
             let keep = lanes.splat_f32(1.0) - selection.fraction;
             for c in 0..4 {
@@ -115,12 +121,13 @@ impl Texture {
     }
 
     /// Filters one level per lane (`level` holds each lane's level index) at `uv`, nearest where
-    /// `nearest` is set and bilinear elsewhere; lanes outside `live` are unspecified. Returns
-    /// [`Channels`].
+    /// `nearest` is set and bilinear elsewhere; lanes outside `live` are unspecified. `srgb` is
+    /// the sRGB decode table in an sRGB texture. Returns [`Channels`].
     #[inline(always)]
     fn sample_level_lanes<L: Lanes>(
         &self,
         sampler: &Sampler,
+        srgb: Option<&[u32; 256]>,
         level: L::I32,
         uv: [L::F32; 2],
         nearest: MaskOf<L>,
@@ -137,7 +144,7 @@ impl Texture {
             let j = sampler
                 .wrap_t
                 .wrap_lanes::<L>(t.coord.to_i32_floor(), height);
-            return self.fetch_lanes::<L>(offset + j * width + i);
+            return self.fetch_lanes::<L>(srgb, offset + j * width + i);
         }
         // Bilinear: texel centres at integer + ½. A nearest lane reads texel ⌊u⌋ with weights
         // (1, 0): t00·1 + t10·0 = t00 exactly, the nearest result.
@@ -157,15 +164,15 @@ impl Texture {
         // the common case), each row's pair of texels is one 8-byte read per lane.
         let neighbours = x1.simd_eq(x0 + one).or(live.not()).all();
         let (t00, t10, t01, t11) = if neighbours {
-            let (t00, t10) = self.fetch_pair_lanes::<L>(row0 + x0);
-            let (t01, t11) = self.fetch_pair_lanes::<L>(row1 + x0);
+            let (t00, t10) = self.fetch_pair_lanes::<L>(srgb, row0 + x0);
+            let (t01, t11) = self.fetch_pair_lanes::<L>(srgb, row1 + x0);
             (t00, t10, t01, t11)
         } else {
             (
-                self.fetch_lanes::<L>(row0 + x0),
-                self.fetch_lanes::<L>(row0 + x1),
-                self.fetch_lanes::<L>(row1 + x0),
-                self.fetch_lanes::<L>(row1 + x1),
+                self.fetch_lanes::<L>(srgb, row0 + x0),
+                self.fetch_lanes::<L>(srgb, row0 + x1),
+                self.fetch_lanes::<L>(srgb, row1 + x0),
+                self.fetch_lanes::<L>(srgb, row1 + x1),
             )
         };
         let (one_alpha, one_beta) = (lanes.splat_f32(1.0) - alpha, lanes.splat_f32(1.0) - beta);
@@ -208,46 +215,50 @@ impl Texture {
 
     /// Gathers the texels at `index` and unpacks them ([`Texture::unpack_lanes`]).
     #[inline(always)]
-    fn fetch_lanes<L: Lanes>(&self, index: L::I32) -> Channels<L> {
-        self.unpack_lanes::<L>(index.gather_u32(&self.texels))
+    fn fetch_lanes<L: Lanes>(&self, srgb: Option<&[u32; 256]>, index: L::I32) -> Channels<L> {
+        unpack_lanes::<L>(srgb, index.gather_u32(&self.texels))
     }
 
     /// The texels at `index` and `index + 1` (one 8-byte read per lane), unpacked
     /// ([`Texture::unpack_lanes`]). `index + 1` must lie in the texture's storage for live lanes.
     #[inline(always)]
-    fn fetch_pair_lanes<L: Lanes>(&self, index: L::I32) -> (Channels<L>, Channels<L>) {
+    fn fetch_pair_lanes<L: Lanes>(
+        &self,
+        srgb: Option<&[u32; 256]>,
+        index: L::I32,
+    ) -> (Channels<L>, Channels<L>) {
         let (first, second) = index.gather_u32_pair(&self.texels);
         (
-            self.unpack_lanes::<L>(first),
-            self.unpack_lanes::<L>(second),
+            unpack_lanes::<L>(srgb, first),
+            unpack_lanes::<L>(srgb, second),
         )
     }
+}
 
-    /// Unpacks packed texels: red, green and blue decoded through the sRGB table in an sRGB
-    /// texture, otherwise every channel as its raw byte value (0–255); alpha always raw.
-    #[inline(always)]
-    fn unpack_lanes<L: Lanes>(&self, texel: L::I32) -> Channels<L> {
-        let lanes = texel.lanes();
-        let a = texel.shr_logical::<24>().to_f32();
-        match self.color_space {
-            ColorSpace::Srgb => {
-                let [r, g, b] = texel.lookup_rgb(decode_table(ColorSpace::Srgb));
-                [
-                    L::F32::from_bits(r),
-                    L::F32::from_bits(g),
-                    L::F32::from_bits(b),
-                    a,
-                ]
-            }
-            ColorSpace::Linear => {
-                let byte = lanes.splat_i32(0xff);
-                [
-                    (texel & byte).to_f32(),
-                    (texel.shr_logical::<8>() & byte).to_f32(),
-                    (texel.shr_logical::<16>() & byte).to_f32(),
-                    a,
-                ]
-            }
+/// Unpacks packed texels: red, green and blue decoded through `srgb` (the sRGB table) in an sRGB
+/// texture, otherwise (`None`) every channel as its raw byte value (0–255); alpha always raw.
+#[inline(always)]
+fn unpack_lanes<L: Lanes>(srgb: Option<&[u32; 256]>, texel: L::I32) -> Channels<L> {
+    let lanes = texel.lanes();
+    let a = texel.shr_logical::<24>().to_f32();
+    match srgb {
+        Some(table) => {
+            let [r, g, b] = texel.lookup_rgb(table);
+            [
+                L::F32::from_bits(r),
+                L::F32::from_bits(g),
+                L::F32::from_bits(b),
+                a,
+            ]
+        }
+        None => {
+            let byte = lanes.splat_i32(0xff);
+            [
+                (texel & byte).to_f32(),
+                (texel.shr_logical::<8>() & byte).to_f32(),
+                (texel.shr_logical::<16>() & byte).to_f32(),
+                a,
+            ]
         }
     }
 }
