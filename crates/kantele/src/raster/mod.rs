@@ -353,22 +353,35 @@ impl EdgeStepper {
         }
     }
 
-    #[inline]
-    fn inside(v: &[i64; 3]) -> bool {
-        (v[0] | v[1] | v[2]) >= 0
-    }
-
     /// Coverage bits of row pixels `x0..x1` (bit `k` = pixel `x0 + k`, at most 64), starting
     /// from the values at `(x0, y)` in `row`.
+    ///
+    /// An edge value is linear along the row, so an edge whose first and last values are both
+    /// inside holds every pixel and one whose both are outside holds none: only the edges that
+    /// cross the row are stepped pixel by pixel (the same values and tests as stepping all
+    /// three, so the same bits).
     #[inline]
     fn row_bits(&self, row: [i64; 3], x0: i32, x1: i32) -> u64 {
-        let mut v = row;
-        let mut bits = 0u64;
-        for k in 0..(x1 - x0) {
-            bits |= (Self::inside(&v) as u64) << k;
-            v[0] += self.step_x[0];
-            v[1] += self.step_x[1];
-            v[2] += self.step_x[2];
+        let n = x1 - x0;
+        if n <= 0 {
+            return 0;
+        }
+        let mut bits = u64::MAX >> (64 - n);
+        for (first, step) in row.into_iter().zip(self.step_x) {
+            let last = first + step * (n - 1) as i64;
+            match (first >= 0, last >= 0) {
+                (true, true) => {}
+                (false, false) => return 0,
+                _ => {
+                    let mut v = first;
+                    let mut edge_bits = 0u64;
+                    for k in 0..n {
+                        edge_bits |= ((v >= 0) as u64) << k;
+                        v += step;
+                    }
+                    bits &= edge_bits;
+                }
+            }
         }
         bits
     }
