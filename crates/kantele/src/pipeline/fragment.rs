@@ -19,7 +19,7 @@ use crate::raster::bin::TileBins;
 use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
 use crate::rop::{BlendMode, BlockRows, Framebuffer, TileBuffer};
 use crate::setup::TriangleSetup;
-use crate::simd::{dispatch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
+use crate::simd::{dispatch, prefetch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
 
 /// Fragment counters of one tile.
 #[derive(Clone, Copy, Debug, Default)]
@@ -76,10 +76,19 @@ pub(super) fn raster_tiles(
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();
             let mut coverage = BlockCoverage::default();
-            for (k, t) in bins.tile(tile_index).enumerate() {
+            let mut refs = bins.tile(tile_index).peekable();
+            let mut k = 0usize;
+            while let Some(t) = refs.next() {
                 // Budget: every few triangles (robust branch).
                 if k % TRIANGLES_PER_CHECK == 0 && budget.exhausted() {
                     break;
+                }
+                k += 1;
+                // The next triangle's records are scattered over what the geometry stage
+                // wrote: start loading them while this one is rasterized.
+                if let Some(&next) = refs.peek() {
+                    prefetch(geometry.triangle(next));
+                    prefetch(geometry.attrs(next));
                 }
                 let tri = geometry.triangle(t);
                 let draw = &draws[tri.draw as usize];

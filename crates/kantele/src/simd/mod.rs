@@ -79,6 +79,7 @@ use std::sync::OnceLock;
 mod avx2;
 #[cfg(target_arch = "aarch64")]
 mod neon;
+mod prefetch;
 mod rounding;
 mod scalar;
 #[cfg(target_arch = "x86_64")]
@@ -92,6 +93,7 @@ mod texel_gather;
 pub use avx2::{Avx2, Avx2F32, Avx2I32, Avx2Mask};
 #[cfg(target_arch = "aarch64")]
 pub use neon::{Neon, NeonF32, NeonI32, NeonMask};
+pub use prefetch::prefetch;
 pub use rounding::{floor, round_ties_even};
 pub use scalar::{Scalar, ScalarF32, ScalarI32, ScalarMask};
 #[cfg(target_arch = "x86_64")]
