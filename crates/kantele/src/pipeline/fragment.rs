@@ -15,7 +15,7 @@ use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
 use super::shader::{vertex_varyings, FragmentLanes, Interpolation, Shader};
 use crate::fixed::pixel_center;
-use crate::raster::bin::TileBins;
+use crate::raster::bin::{TileBins, TriangleRef};
 use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
 use crate::rop::{BlendMode, BlockRows, Framebuffer, TileBuffer};
 use crate::setup::TriangleSetup;
@@ -76,19 +76,10 @@ pub(super) fn raster_tiles(
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();
             let mut coverage = BlockCoverage::default();
-            let mut refs = bins.tile(tile_index).peekable();
-            let mut k = 0usize;
-            while let Some(t) = refs.next() {
+            for (k, t) in binned_triangles(bins, geometry, tile_index) {
                 // Budget: every few triangles (robust branch).
                 if k % TRIANGLES_PER_CHECK == 0 && budget.exhausted() {
                     break;
-                }
-                k += 1;
-                // The next triangle's records are scattered over what the geometry stage
-                // wrote: start loading them while this one is rasterized.
-                if let Some(&next) = refs.peek() {
-                    prefetch(geometry.triangle(next));
-                    prefetch(geometry.attrs(next));
                 }
                 let tri = geometry.triangle(t);
                 let draw = &draws[tri.draw as usize];
@@ -113,6 +104,26 @@ pub(super) fn raster_tiles(
             counters
         })
         .reduce(RasterCounters::default, RasterCounters::sum)
+}
+
+/// The triangles of tile `tile_index`'s bin in submission order, numbered from 0. When one is
+/// handed out, the next one's setup record and varyings are prefetched: they are scattered over
+/// what the geometry stage wrote, and would miss the cache when the next triangle is reached.
+pub(super) fn binned_triangles<'a>(
+    bins: &'a TileBins,
+    geometry: &'a GeometryOutput<'_>,
+    tile_index: usize,
+) -> impl Iterator<Item = (usize, TriangleRef)> + 'a {
+    let mut refs = bins.tile(tile_index).peekable();
+    std::iter::from_fn(move || {
+        let current = refs.next()?;
+        if let Some(&next) = refs.peek() {
+            prefetch(geometry.triangle(next));
+            prefetch(geometry.attrs(next));
+        }
+        Some(current)
+    })
+    .enumerate()
 }
 
 /// Shades one triangle's covered pixels in one tile with the instruction set `isa`.

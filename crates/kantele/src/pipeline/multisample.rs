@@ -19,7 +19,7 @@ use rayon::prelude::*;
 
 use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::draw::{DrawCall, DrawJob};
-use super::fragment::{RasterCounters, TriangleLanes};
+use super::fragment::{binned_triangles, RasterCounters, TriangleLanes};
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
 use super::shader::{vertex_varyings, FragmentLanes, Interpolation, Shader};
@@ -52,7 +52,7 @@ pub(super) fn raster_tiles_multisampled(
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();
             let mut coverage = SampleCoverage::default();
-            for (k, t) in bins.tile(tile_index).enumerate() {
+            for (k, t) in binned_triangles(bins, geometry, tile_index) {
                 if k % TRIANGLES_PER_CHECK == 0 && budget.exhausted() {
                     break;
                 }

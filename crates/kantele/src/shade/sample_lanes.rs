@@ -213,14 +213,14 @@ impl Texture {
         }
     }
 
-    /// Gathers the texels at `index` and unpacks them ([`Texture::unpack_lanes`]).
+    /// Gathers the texels at `index` and unpacks them ([`unpack_lanes`]).
     #[inline(always)]
     fn fetch_lanes<L: Lanes>(&self, srgb: Option<&[u32; 256]>, index: L::I32) -> Channels<L> {
         unpack_lanes::<L>(srgb, index.gather_u32(&self.texels))
     }
 
     /// The texels at `index` and `index + 1` (one 8-byte read per lane), unpacked
-    /// ([`Texture::unpack_lanes`]). `index + 1` must lie in the texture's storage for live lanes.
+    /// ([`unpack_lanes`]). `index + 1` must lie in the texture's storage for live lanes.
     #[inline(always)]
     fn fetch_pair_lanes<L: Lanes>(
         &self,
