@@ -1,0 +1,430 @@
+//! One tile's storage: colour and depth planes laid out for lanes, the per-tile and per-block
+//! depth bounds (the depth hierarchy), and the deferred clear.
+
+use glam::Vec4;
+
+use super::depth_planes;
+use crate::error::RenderError;
+use crate::fixed::{BLOCK_LOG2, BLOCK_SIZE, TILE_LOG2, TILE_PIXELS, TILE_SIZE};
+use crate::multisample::SampleCount;
+use crate::setup::PixelRect;
+
+/// 8 × 8 blocks in a tile (64).
+const BLOCKS_PER_TILE: usize = ((TILE_SIZE >> BLOCK_LOG2) * (TILE_SIZE >> BLOCK_LOG2)) as usize;
+
+/// One tile's colour and depth, `TILE_SIZE × TILE_SIZE`, row-major within the tile. Colour is
+/// stored as four planes (red, green, blue, alpha; structure of arrays) so that eight adjacent
+/// pixels of a row are one lane load per channel.
+///
+/// A multisampled tile (N samples) holds N planes per channel (channel `c`, sample `s` at plane
+/// `c·N + s`) and N + 1 depth planes: plane 0 is the depth at the pixel centre (the per-pixel
+/// depth read back, see [`crate::multisample`]), plane `1 + s` that of sample `s`. At 1× the
+/// single colour plane per channel and depth plane 0 are the only ones, as before.
+#[derive(Clone, Debug)]
+pub struct TileBuffer {
+    /// Linear colour planes: red at `0..TILE_PIXELS·N`, then green, blue and alpha.
+    color: Vec<f32>,
+    /// Window depth planes: the pixel centre's, then each sample's (multisampled only).
+    depth: Vec<f32>,
+    /// Samples per pixel (1, 4 or 8).
+    samples: usize,
+    /// An upper bound of every value in `depth` (kept by every depth write).
+    depth_bound: f32,
+    /// Whether `depth_bound` is the exact maximum (false after writes until recomputed).
+    depth_bound_exact: bool,
+    /// The largest depth of each 8 × 8 block (row-major blocks of the tile), kept exact by the
+    /// per-pixel path after every block it writes: the second level of the depth hierarchy.
+    block_depth_max: [f32; BLOCKS_PER_TILE],
+    /// A clear not yet written to the storage: while set, every pixel and sample of the tile
+    /// holds this colour and depth, whatever `color` and `depth` contain. Clearing a frame only
+    /// sets it; the first triangle that reaches the tile writes it out
+    /// ([`TileBuffer::materialize`]), in the thread that rasterizes the tile, so the tile is
+    /// in cache for its triangles, and a tile that no triangle reaches is never written.
+    deferred_clear: Option<DeferredClear>,
+}
+
+/// The values of a clear that a tile has not written to its storage yet.
+#[derive(Clone, Copy, Debug)]
+struct DeferredClear {
+    color: Vec4,
+    depth: f32,
+}
+
+/// Pixels from the first of an 8 × 8 block to its last, in a tile's row-major order: seven
+/// tile rows and one block row.
+pub const BLOCK_SPAN: usize = (BLOCK_SIZE as usize - 1) * TILE_SIZE as usize + BLOCK_SIZE as usize;
+
+/// The depth and colour (red, green, blue, alpha planes) of one 8 × 8 block of a single-sample
+/// tile, each from the block's first pixel on: block row `r` starts at `r · TILE_SIZE`.
+pub struct BlockRows<'a> {
+    /// Window depths.
+    pub depth: &'a mut [f32; BLOCK_SPAN],
+    /// Linear colour planes.
+    pub color: [&'a mut [f32; BLOCK_SPAN]; 4],
+}
+
+impl BlockRows<'_> {
+    /// Offset of block row `row` (0..8) from the block's first pixel.
+    #[inline(always)]
+    pub fn row_offset(row: usize) -> usize {
+        row * TILE_SIZE as usize
+    }
+}
+
+/// The [`BLOCK_SPAN`] values of `plane` from the block's first pixel `first` on.
+#[inline(always)]
+fn block_span(plane: &mut [f32], first: usize) -> &mut [f32; BLOCK_SPAN] {
+    plane[first..]
+        .first_chunk_mut::<BLOCK_SPAN>()
+        .expect("an 8 x 8 block lies inside its tile")
+}
+
+/// Margin below a triangle's smallest vertex depth. Interpolated depth is clamped to the
+/// vertex range (`TriangleSetup::depth_at`), so none is needed; this is belt and braces.
+const DEPTH_BOUND_SLACK: f32 = 1e-6;
+
+/// Least triangle ∩ tile area (pixels) for which a stale depth bound is recomputed: scanning
+/// 4096 depths pays off only when the triangle could cover many pixels.
+const DEPTH_BOUND_REFRESH_AREA: i32 = 1024;
+
+impl TileBuffer {
+    pub(super) fn new(samples: SampleCount) -> Result<Self, RenderError> {
+        let n = samples.count();
+        Ok(Self {
+            color: filled_vec(4 * n * TILE_PIXELS, 0.0)?,
+            depth: filled_vec(depth_planes(samples) * TILE_PIXELS, 1.0)?,
+            samples: n,
+            depth_bound: 1.0,
+            depth_bound_exact: true,
+            block_depth_max: [1.0; BLOCKS_PER_TILE],
+            deferred_clear: None,
+        })
+    }
+
+    /// Depths of the row starting at tile index `index` (to the end of the tile).
+    #[inline(always)]
+    pub fn depth_row(&self, index: usize) -> &[f32] {
+        self.debug_assert_materialized();
+        &self.depth[index..]
+    }
+
+    /// Mutable depths of the row starting at tile index `index`; call
+    /// [`TileBuffer::note_depth_written`] after writing.
+    #[inline(always)]
+    pub fn depth_row_mut(&mut self, index: usize) -> &mut [f32] {
+        self.debug_assert_materialized();
+        &mut self.depth[index..]
+    }
+
+    /// The depth and colour rows of the 8 × 8 block whose first pixel has tile index `first`
+    /// (single-sample tiles): fixed-size views, so the per-pixel loop indexes its rows without
+    /// bounds checks.
+    #[inline(always)]
+    pub fn block_rows_mut(&mut self, first: usize) -> BlockRows<'_> {
+        self.debug_assert_materialized();
+        debug_assert_eq!(self.samples, 1);
+        let (r, rest) = self.color.split_at_mut(TILE_PIXELS);
+        let (g, rest) = rest.split_at_mut(TILE_PIXELS);
+        let (b, a) = rest.split_at_mut(TILE_PIXELS);
+        BlockRows {
+            depth: block_span(&mut self.depth, first),
+            color: [
+                block_span(r, first),
+                block_span(g, first),
+                block_span(b, first),
+                block_span(a, first),
+            ],
+        }
+    }
+
+    /// Samples per pixel of this tile.
+    #[inline(always)]
+    pub fn samples(&self) -> usize {
+        self.samples
+    }
+
+    /// Depths of sample `sample` from tile index `index` on (multisampled tiles only).
+    #[inline(always)]
+    pub fn sample_depth_row(&self, sample: usize, index: usize) -> &[f32] {
+        self.debug_assert_materialized();
+        debug_assert!(self.samples > 1 && sample < self.samples);
+        &self.depth[(1 + sample) * TILE_PIXELS + index..]
+    }
+
+    /// Mutable depths of sample `sample` from tile index `index` on (multisampled tiles only).
+    #[inline(always)]
+    pub fn sample_depth_row_mut(&mut self, sample: usize, index: usize) -> &mut [f32] {
+        self.debug_assert_materialized();
+        debug_assert!(self.samples > 1 && sample < self.samples);
+        &mut self.depth[(1 + sample) * TILE_PIXELS + index..]
+    }
+
+    /// Depths of depth plane `plane` (0: pixel centres, `1 + s`: sample `s`) from tile index
+    /// `index` on.
+    #[inline(always)]
+    pub fn depth_plane_row(&self, plane: usize, index: usize) -> &[f32] {
+        self.debug_assert_materialized();
+        &self.depth[plane * TILE_PIXELS + index..]
+    }
+
+    /// Number of depth planes (1 at 1×, samples + 1 when multisampled).
+    #[inline(always)]
+    pub fn depth_plane_count(&self) -> usize {
+        self.depth.len() / TILE_PIXELS
+    }
+
+    /// The four colour planes of sample `sample` from tile index `index` on.
+    #[inline(always)]
+    pub fn sample_color_row(&self, sample: usize, index: usize) -> [&[f32]; 4] {
+        self.debug_assert_materialized();
+        let plane = self.samples * TILE_PIXELS;
+        let at = sample * TILE_PIXELS + index;
+        [
+            &self.color[at..],
+            &self.color[plane + at..],
+            &self.color[2 * plane + at..],
+            &self.color[3 * plane + at..],
+        ]
+    }
+
+    /// The four colour planes of sample `sample` from tile index `index` on, mutable.
+    #[inline(always)]
+    pub fn sample_color_row_mut(&mut self, sample: usize, index: usize) -> [&mut [f32]; 4] {
+        self.debug_assert_materialized();
+        let plane = self.samples * TILE_PIXELS;
+        let at = sample * TILE_PIXELS + index;
+        let (r, rest) = self.color.split_at_mut(plane);
+        let (g, rest) = rest.split_at_mut(plane);
+        let (b, a) = rest.split_at_mut(plane);
+        [&mut r[at..], &mut g[at..], &mut b[at..], &mut a[at..]]
+    }
+
+    /// The four colour planes from tile index `index` on (single-sample tiles).
+    #[inline(always)]
+    pub fn color_row(&self, index: usize) -> [&[f32]; 4] {
+        self.debug_assert_materialized();
+        debug_assert_eq!(self.samples, 1);
+        let (r, rest) = self.color.split_at(TILE_PIXELS);
+        let (g, rest) = rest.split_at(TILE_PIXELS);
+        let (b, a) = rest.split_at(TILE_PIXELS);
+        [&r[index..], &g[index..], &b[index..], &a[index..]]
+    }
+
+    /// The four colour planes from tile index `index` on, mutable (single-sample tiles).
+    #[inline(always)]
+    pub fn color_row_mut(&mut self, index: usize) -> [&mut [f32]; 4] {
+        self.debug_assert_materialized();
+        debug_assert_eq!(self.samples, 1);
+        let (r, rest) = self.color.split_at_mut(TILE_PIXELS);
+        let (g, rest) = rest.split_at_mut(TILE_PIXELS);
+        let (b, a) = rest.split_at_mut(TILE_PIXELS);
+        [
+            &mut r[index..],
+            &mut g[index..],
+            &mut b[index..],
+            &mut a[index..],
+        ]
+    }
+
+    /// The colour of the pixel at tile index `index`; on a multisampled tile the resolved
+    /// colour: the mean of its samples in linear space (summed in sample order).
+    #[inline]
+    pub fn color_at(&self, index: usize) -> Vec4 {
+        // A deferred clear resolves through the same sum and division as stored samples, so it
+        // reads back bit for bit as a written one.
+        match self.deferred_clear {
+            Some(clear) => self.resolve(|c, _| clear.color[c]),
+            None => {
+                let plane = self.samples * TILE_PIXELS;
+                self.resolve(|c, s| self.color[c * plane + s * TILE_PIXELS + index])
+            }
+        }
+    }
+
+    /// A pixel's colour from `sample(channel, sample)`: the value itself at 1×, the mean of the
+    /// samples (summed in sample order) when multisampled.
+    #[inline]
+    fn resolve(&self, sample: impl Fn(usize, usize) -> f32) -> Vec4 {
+        if self.samples == 1 {
+            return Vec4::from_array(std::array::from_fn(|c| sample(c, 0)));
+        }
+        let mut sum = [0.0f32; 4];
+        for (c, total) in sum.iter_mut().enumerate() {
+            for s in 0..self.samples {
+                *total += sample(c, s);
+            }
+        }
+        Vec4::from_array(sum) / self.samples as f32
+    }
+
+    /// The depth of the pixel at tile index `index`.
+    #[inline]
+    pub fn depth_at(&self, index: usize) -> f32 {
+        match self.deferred_clear {
+            Some(clear) => clear.depth,
+            None => self.depth[index],
+        }
+    }
+
+    /// Writes a deferred clear to the storage (nothing when none is pending). The per-pixel
+    /// paths call it before they touch the tile's colour or depth.
+    #[inline]
+    pub(crate) fn materialize(&mut self) {
+        if let Some(clear) = self.deferred_clear.take() {
+            self.write_color(clear.color);
+            self.depth.fill(clear.depth);
+        }
+    }
+
+    /// Sets every sample's colour in the storage.
+    fn write_color(&mut self, color: Vec4) {
+        let plane = self.samples * TILE_PIXELS;
+        for (planes, value) in self.color.chunks_exact_mut(plane).zip(color.to_array()) {
+            planes.fill(value);
+        }
+    }
+
+    /// Panics (debug builds) if the storage is read or written while a clear is deferred.
+    #[inline(always)]
+    fn debug_assert_materialized(&self) {
+        debug_assert!(
+            self.deferred_clear.is_none(),
+            "tile storage used before materialize"
+        );
+    }
+
+    /// Index of the 8 × 8 block holding absolute pixel `(x, y)` within its tile.
+    #[inline(always)]
+    pub fn block_index(x: i32, y: i32) -> usize {
+        let mask = (TILE_SIZE >> BLOCK_LOG2) as i32 - 1;
+        ((((y >> BLOCK_LOG2) & mask) << (TILE_LOG2 - BLOCK_LOG2)) | ((x >> BLOCK_LOG2) & mask))
+            as usize
+    }
+
+    /// Whether a triangle whose vertex depths are at least `min_depth` fails a LESS or LEQUAL
+    /// test on every pixel of block `block` (so the block can be skipped).
+    #[inline(always)]
+    pub fn block_occludes(&self, block: usize, min_depth: f32) -> bool {
+        min_depth - DEPTH_BOUND_SLACK > self.block_depth_max[block]
+    }
+
+    /// Records the exact largest depth of block `block` after the per-pixel path wrote it, and
+    /// keeps the tile's bound valid.
+    #[inline(always)]
+    pub fn set_block_depth_max(&mut self, block: usize, max_depth: f32) {
+        self.block_depth_max[block] = max_depth;
+        self.note_depth_written(max_depth);
+    }
+
+    /// Records that depths up to `max_depth` were written, keeping the tile's bound valid.
+    #[inline]
+    pub fn note_depth_written(&mut self, max_depth: f32) {
+        self.depth_bound = self.depth_bound.max(max_depth);
+        self.depth_bound_exact = false;
+    }
+
+    /// Fills colour and/or depth. Clearing both is deferred ([`TileBuffer::materialize`]);
+    /// clearing one of them writes a pending clear first, then that one.
+    pub(super) fn fill(&mut self, color: Option<Vec4>, depth: Option<f32>) {
+        match (color, depth) {
+            (Some(color), Some(depth)) => {
+                self.deferred_clear = Some(DeferredClear { color, depth })
+            }
+            _ => {
+                self.materialize();
+                if let Some(c) = color {
+                    self.write_color(c);
+                }
+                if let Some(d) = depth {
+                    self.depth.fill(d);
+                }
+            }
+        }
+        if let Some(d) = depth {
+            self.depth_bound = d;
+            self.depth_bound_exact = true;
+            self.block_depth_max = [d; BLOCKS_PER_TILE];
+        }
+    }
+
+    /// Whether every fragment of a triangle whose vertex depths are at least `min_depth` would
+    /// fail a LESS or LEQUAL test in this tile (so the triangle can be skipped here without
+    /// changing the picture). `tile` is the tile's rectangle on the target and `area` the area
+    /// of the triangle's box within it, used to decide whether a stale bound is worth
+    /// recomputing.
+    #[inline]
+    pub fn occludes(&mut self, min_depth: f32, area: i32, tile: &PixelRect) -> bool {
+        let min_depth = min_depth - DEPTH_BOUND_SLACK;
+        if min_depth > self.depth_bound {
+            return true;
+        }
+        let tile_area = tile.width() * tile.height();
+        if self.depth_bound_exact || area < DEPTH_BOUND_REFRESH_AREA.min(tile_area / 4) {
+            return false;
+        }
+        self.depth_bound = self.exact_depth_bound(tile);
+        self.depth_bound_exact = true;
+        min_depth > self.depth_bound
+    }
+
+    /// The largest depth of the tile's pixels on the target (`tile` is the tile's rectangle on
+    /// it; pixels past its edge keep the clear value forever), over every depth plane (the
+    /// pixel centres' and, when multisampled, each sample's). A block wholly on the target
+    /// gives its exact maximum, kept by the per-pixel paths, so only blocks cut by the
+    /// target's edge are read pixel by pixel: 64 values instead of 4096 for an inner tile.
+    fn exact_depth_bound(&self, tile: &PixelRect) -> f32 {
+        if let Some(clear) = self.deferred_clear {
+            return clear.depth;
+        }
+        let block = BLOCK_SIZE as i32;
+        let mut bound = f32::NEG_INFINITY;
+        for by in 0..(TILE_SIZE as i32 / block) {
+            let y0 = tile.y0 + by * block;
+            let y1 = (y0 + block).min(tile.y1);
+            if y0 >= y1 {
+                break;
+            }
+            for bx in 0..(TILE_SIZE as i32 / block) {
+                let x0 = tile.x0 + bx * block;
+                let x1 = (x0 + block).min(tile.x1);
+                if x0 >= x1 {
+                    break;
+                }
+                if y1 - y0 == block && x1 - x0 == block {
+                    bound = bound.max(self.block_depth_max[Self::block_index(x0, y0)]);
+                    continue;
+                }
+                for plane in self.depth.chunks_exact(TILE_PIXELS) {
+                    for y in y0..y1 {
+                        let row = Self::index(x0, y);
+                        bound = plane[row..row + (x1 - x0) as usize]
+                            .iter()
+                            .copied()
+                            .fold(bound, f32::max);
+                    }
+                }
+            }
+        }
+        bound
+    }
+
+    /// Index of absolute pixel `(x, y)` within the tile (the tile's origin is a multiple of
+    /// `TILE_SIZE`).
+    #[inline]
+    pub fn index(x: i32, y: i32) -> usize {
+        let mask = TILE_SIZE as i32 - 1;
+        (((y & mask) << TILE_LOG2) | (x & mask)) as usize
+    }
+}
+
+/// A vector of `n` copies of `value`, or an error instead of an abort when memory runs out.
+fn filled_vec<T: Clone>(n: usize, value: T) -> Result<Vec<T>, RenderError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| RenderError::OutOfMemory {
+            what: "render target",
+            bytes: n.saturating_mul(std::mem::size_of::<T>()),
+        })?;
+    v.resize(n, value);
+    Ok(v)
+}
