@@ -1,6 +1,6 @@
 // Reads triangles (clip-space positions and varyings as f32 bit patterns) and prints what the
 // CUDA kernels' device functions (common.cuh) make of them: classification, clipping, setup,
-// barycentrics and depth at sample pixels. `tests/host_reference.rs` prints the same from the
+// barycentrics and depth at sample pixels. `tests/cuda/host_reference.rs` prints the same from the
 // Rust core and compares.
 #include "host_shim.h"
 #include "../../kernels/common.cuh"

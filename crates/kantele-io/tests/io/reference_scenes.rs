@@ -2,8 +2,6 @@
 // Quaternions are copied digit for digit from the files.
 #![allow(clippy::excessive_precision)]
 
-mod common;
-
 use glam::{Mat4, Quat, Vec3};
 use kantele::scene::{AlphaMode, Light};
 use kantele::shade::texture::{MinFilter, Wrap};
@@ -32,14 +30,14 @@ const INDEX: &[(&str, (u32, u32), usize, usize)] = &[
 ];
 
 fn load(name: &str) -> Option<LoadedScene> {
-    let dir = common::reference_scenes()?;
+    let dir = crate::common::reference_scenes()?;
     let path = dir.join(name);
     Some(load_scene(&path).unwrap_or_else(|e| panic!("{name}: {e}")))
 }
 
 #[test]
 fn every_reference_scene_loads_with_its_index_counts() {
-    let Some(dir) = common::reference_scenes() else {
+    let Some(dir) = crate::common::reference_scenes() else {
         return;
     };
     // Every .glb in the directory is in the table.

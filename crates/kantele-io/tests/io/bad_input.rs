@@ -1,10 +1,8 @@
 //! Broken files give an error that names the file, never a panic.
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use kantele_io::{load_scene, load_scene_with, LoadError, LoadOptions};
 use serde_json::json;
 

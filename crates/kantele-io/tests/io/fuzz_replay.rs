@@ -2,10 +2,8 @@
 //! deterministic pseudo-random mutations of them, through the same bodies `cargo fuzz` runs
 //! (`kantele::fuzz_targets`, `kantele_io::fuzz_targets`). A defect panics, failing the test.
 //!
-//! The seed files are generated, not hand-edited: `cargo test -p kantele-io --test fuzz_replay
+//! The seed files are generated, not hand-edited: `cargo test -p kantele-io --test io
 //! -- --ignored write_seed_corpus` writes them (inputs the fuzzer found stay as they are).
-
-mod common;
 
 use std::path::{Path, PathBuf};
 
@@ -181,7 +179,7 @@ fn clip_corpus_and_mutations() {
 fn write_seed_corpus() {
     let gltf = corpus_dir("gltf");
     std::fs::create_dir_all(&gltf).expect("corpus dir");
-    let quad = common::textured_quad();
+    let quad = crate::common::textured_quad();
     quad.write_glb(&gltf.join("seed-textured-quad.glb"));
     quad.write_gltf_embedded(&gltf.join("seed-textured-quad.gltf"));
     cube_gltf().write_glb(&gltf.join("seed-builtin-cube.glb"));
@@ -239,10 +237,10 @@ fn write_seed_corpus() {
 }
 
 /// The built-in cube (positions, normals, indices) as a glTF document.
-fn cube_gltf() -> common::Gltf {
+fn cube_gltf() -> crate::common::Gltf {
     let loaded = kantele_io::builtin_scene("cube").expect("built-in cube");
     let mesh = &loaded.scene.meshes[0];
-    let mut g = common::Gltf::new();
+    let mut g = crate::common::Gltf::new();
     let positions: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
     let position = g.vec3(&positions);
     let mut attributes = json!({"POSITION": position});
@@ -301,7 +299,7 @@ fn sparse_strip() -> String {
         ],
         "buffers": [{
             "byteLength": bin.len(),
-            "uri": format!("data:application/octet-stream;base64,{}", common::base64(&bin)),
+            "uri": format!("data:application/octet-stream;base64,{}", crate::common::base64(&bin)),
         }],
     });
     serde_json::to_string(&document).expect("json")

@@ -10,9 +10,7 @@ use kantele::multisample::SampleCount;
 use kantele::RenderError;
 use kantele_io::compare::{compare, edge_mask, Comparison};
 
-mod common;
-
-use common::{
+use crate::common::{
     gl_or_skip, interior_allowance, is_textured_scene, print_comparison, reference_scene_files,
     render, render_both_at, INTERIOR_BOUND,
 };

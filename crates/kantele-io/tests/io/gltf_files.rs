@@ -1,11 +1,9 @@
 //! glTF files written by the tests: the three storage forms give the same scene, and every rule
 //! of the loader (hierarchy, camera, light, extras, materials, samplers, attributes).
 
-mod common;
-
 use std::path::Path;
 
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use kantele::scene::{AlphaMode, Light, Scene};
 use kantele::shade::texture::{Filter, MinFilter, Wrap};

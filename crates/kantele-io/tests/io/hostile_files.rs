@@ -3,12 +3,10 @@
 //! Big inputs are generated here and run in a child process under `ulimit -v`, so an
 //! allocation that slipped past the budget would abort the child and fail the test.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use common::*;
+use crate::common::*;
 use kantele_io::{load_scene, load_scene_with, LoadOptions};
 use serde_json::json;
 

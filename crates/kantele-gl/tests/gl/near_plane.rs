@@ -17,9 +17,7 @@ use kantele::camera;
 use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::scene::{Camera, Draw, Light, Material, Mesh, Scene, Topology};
 
-mod common;
-
-use common::{gl_or_skip, render};
+use crate::common::{gl_or_skip, render};
 
 /// A square ground plane at y = 0 reaching ±`extent`, facing up, as two triangles, unlit white
 /// with a per-corner colour (so a wrongly clipped corner also shows in the colours).

@@ -7,9 +7,7 @@ use std::path::Path;
 
 use kantele_io::compare::{compare, edge_mask, Comparison};
 
-mod common;
-
-use common::{
+use crate::common::{
     gl_or_skip, interior_allowance, is_textured_scene, print_comparison, reference_scene_files,
     render_both, INTERIOR_BOUND,
 };

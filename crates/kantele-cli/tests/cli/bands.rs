@@ -6,9 +6,7 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
-
-use common::{kantele, ok, stderr, TempDir, BIN};
+use crate::common::{kantele, ok, stderr, TempDir, BIN};
 
 /// The sidecar without its timing (`render_ms`) and file names, which differ between runs.
 fn sidecar_without_timing(path: &Path) -> serde_json::Value {

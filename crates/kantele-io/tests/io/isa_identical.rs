@@ -2,8 +2,6 @@
 //! strategy and thread count: every reference scene and every built-in scene, rendered with the
 //! scalar build (the readable reference) and with each SIMD build the machine has.
 
-mod common;
-
 use std::sync::Arc;
 
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
@@ -83,7 +81,7 @@ fn simd_builds_match_the_scalar_reference_on_built_in_scenes() {
 
 #[test]
 fn simd_builds_match_the_scalar_reference_on_reference_scenes() {
-    let Some(dir) = common::reference_scenes() else {
+    let Some(dir) = crate::common::reference_scenes() else {
         return;
     };
     let mut files: Vec<_> = std::fs::read_dir(&dir)

@@ -6,12 +6,10 @@
 //! is absent the test says so and skips them, unless `KANTELE_REQUIRE` contains `scenes`,
 //! where it fails. The shared folder is `../shared` beside the checkout, or `KANTELE_SHARED`.
 
-mod common;
-
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
-use common::*;
+use crate::common::*;
 use glam::Vec4;
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::cpu::{CpuBackend, CpuOptions};

@@ -12,9 +12,7 @@ use kantele::backend::{Backend, FrameImage, FrameView};
 use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::scene::{Draw, Material, Mesh, Scene, Topology};
 
-mod common;
-
-use common::{gl_or_skip, render};
+use crate::common::{gl_or_skip, render};
 
 const W: u32 = 160;
 const H: u32 = 120;

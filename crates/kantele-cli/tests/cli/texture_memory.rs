@@ -7,12 +7,10 @@
 //! `KANTELE_TEXTURE_MEMORY_DIR=FOLDER` writes it there and keeps it, for a manual measurement
 //! (`BENCHMARKS.md`); the default, 1024² in a temporary folder, keeps the test to seconds.
 
-mod common;
-
 use std::path::Path;
 use std::process::Command;
 
-use common::{TempDir, BIN};
+use crate::common::{TempDir, BIN};
 
 const TEXTURES: usize = 10;
 

@@ -8,9 +8,7 @@ use kantele::reference::reference_covers;
 use kantele::simd::Isa;
 use proptest::prelude::*;
 
-mod common;
-
-use common::{busy_frame, jittered_grid, red_channel};
+use crate::common::{busy_frame, jittered_grid, red_channel};
 
 /// Renders `triangles` (NDC positions) with the counting shader; returns per-pixel counts.
 fn coverage_counts(

@@ -1,8 +1,6 @@
 //! OBJ + MTL files written by the tests.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use kantele::scene::{AlphaMode, Light};
 use kantele::shade::texture::{MinFilter, Wrap};

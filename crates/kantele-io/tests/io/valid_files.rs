@@ -1,9 +1,7 @@
 //! Valid glTF that the `gltf` crate alone would reject, and KHR_mesh_quantization's attribute
 //! types: each loads with the values the spec defines.
 
-mod common;
-
-use common::*;
+use crate::common::*;
 use glam::{Vec2, Vec3, Vec4};
 use kantele_io::load_scene;
 use serde_json::json;

@@ -1,9 +1,7 @@
 //! `--msaa` through the binary: antialiased edges in the picture, per-pixel depth and ids equal
 //! to a 1× render's, the thumbnail preset's soft edges, and a clear error for other counts.
 
-mod common;
-
-use common::{kantele, ok, stderr, TempDir};
+use crate::common::{kantele, ok, stderr, TempDir};
 
 /// One flat-lit triangle with slanted edges.
 const TRIANGLE: &str = "v 0 0 0\nv 4 1 0\nv 1 3 0\nvn 0 0 1\nf 1//1 2//1 3//1\n";

@@ -12,9 +12,7 @@ use kantele::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, W
 use kantele_gl::GlBackend;
 use kantele_io::compare::{compare, edge_mask};
 
-mod common;
-
-use common::{gl_or_skip, render_both};
+use crate::common::{gl_or_skip, render_both};
 
 /// Renders with both backends and checks agreement (the reference-scene tolerances).
 fn assert_agree(name: &str, scene: Scene, gl: &mut GlBackend) {

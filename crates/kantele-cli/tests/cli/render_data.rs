@@ -6,9 +6,7 @@ use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
-mod common;
-
-use common::{kantele, ok, TempDir, BIN};
+use crate::common::{kantele, ok, TempDir, BIN};
 
 fn err_line(o: &Output) -> String {
     assert!(!o.status.success(), "expected a failure");
@@ -554,6 +552,6 @@ fn thumbnail_is_square_framed_and_transparent() {
         ["t.obj", "t.png"],
         "no sidecar, no temporaries"
     );
-    let entry = include_str!("../data/kantele.thumbnailer");
+    let entry = include_str!("../../data/kantele.thumbnailer");
     assert!(entry.contains("Exec=kantele thumbnail %i %o --size %s"));
 }

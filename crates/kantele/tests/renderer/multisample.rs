@@ -14,9 +14,7 @@ use kantele::scene::{Camera, Draw, Material, Mesh, Scene};
 use kantele::simd::Isa;
 use kantele::RenderError;
 
-mod common;
-
-use common::{busy_frame, jittered_grid, red_channel};
+use crate::common::{busy_frame, jittered_grid, red_channel};
 
 /// The size of the busy frame.
 const SIZE: (u32, u32) = (181, 133);
