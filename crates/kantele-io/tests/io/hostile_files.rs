@@ -62,7 +62,7 @@ fn crc32(bytes: &[u8]) -> u32 {
 fn load_in_capped_child(path: &Path, limit_mib: u64) -> (bool, String) {
     let exe = std::env::current_exe().unwrap();
     let script = format!(
-        "ulimit -v {} && exec \"$0\" child_load --exact --nocapture --test-threads=1",
+        "ulimit -v {} && exec \"$0\" hostile_files::child_load --exact --nocapture --test-threads=1",
         limit_mib * 1024
     );
     let out = Command::new("sh")
