@@ -397,23 +397,52 @@ impl EdgeStepper {
     }
 }
 
+// A row of a tile is one `u64` of coverage bits.
+const _: () = assert!(TILE_SIZE <= 64);
+
 /// Bounding-box scan with incremental edge functions: one add per edge per pixel.
+///
+/// Works one block row (8 pixel rows) at a time: the row's coverage bits go into the masks of
+/// that block row's blocks a block's byte at a time, and the block row's non-empty blocks are
+/// appended before the next is scanned (row-major, as [`TileMasks::emit`] orders them). Small
+/// triangles, this strategy's usual work, touch one or two blocks: nothing is cleared or
+/// visited for the rest of the tile.
 fn scan_incremental(tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverage) {
     let stepper = EdgeStepper::at(tri, rect.x0, rect.y0);
-    let mut masks = TileMasks::new();
+    let block = BLOCK_SIZE as i32;
+    let tile_x = rect.x0 & !(TILE_SIZE as i32 - 1);
+    // The rectangle's block columns, counted from the tile's left edge.
+    let (bx0, bx1) = (
+        ((rect.x0 - tile_x) >> BLOCK_LOG2) as usize,
+        (((rect.x1 - 1 - tile_x) >> BLOCK_LOG2) + 1) as usize,
+    );
+    // Bit `c` of a row's bits shifted by this = tile column `c` (the rectangle lies in the
+    // tile, so nothing is shifted out).
+    let column_shift = (rect.x0 - tile_x) as u32;
     let mut row = stepper.value;
-    for y in rect.y0..rect.y1 {
-        let mut bits = stepper.row_bits(row, rect.x0, rect.x1);
-        while bits != 0 {
-            let k = bits.trailing_zeros() as i32;
-            masks.set(rect.x0 + k, y);
-            bits &= bits - 1;
+    let mut y = rect.y0;
+    while y < rect.y1 {
+        let block_y = y & !(block - 1);
+        let band_end = (block_y + block).min(rect.y1);
+        let mut masks = [0u64; (TILE_SIZE / BLOCK_SIZE) as usize];
+        for y in y..band_end {
+            let mut bits = stepper.row_bits(row, rect.x0, rect.x1) << column_shift;
+            let shift = ((y & (block - 1)) << BLOCK_LOG2) as u32;
+            while bits != 0 {
+                let bx = (bits.trailing_zeros() >> BLOCK_LOG2) as usize;
+                let first = (bx as u32) << BLOCK_LOG2;
+                masks[bx] |= ((bits >> first) & 0xff) << shift;
+                bits &= !(0xffu64 << first);
+            }
+            row[0] += stepper.step_y[0];
+            row[1] += stepper.step_y[1];
+            row[2] += stepper.step_y[2];
         }
-        row[0] += stepper.step_y[0];
-        row[1] += stepper.step_y[1];
-        row[2] += stepper.step_y[2];
+        for (bx, &mask) in masks.iter().enumerate().take(bx1).skip(bx0) {
+            out.push(tile_x + ((bx as i32) << BLOCK_LOG2), block_y, mask);
+        }
+        y = band_end;
     }
-    masks.emit(rect, out);
 }
 
 /// How a block relates to the triangle, judged by the edge values at its corner pixels.
