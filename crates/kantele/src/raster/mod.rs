@@ -357,9 +357,9 @@ impl EdgeStepper {
     /// from the values at `(x0, y)` in `row`.
     ///
     /// An edge value is linear along the row, so an edge whose first and last values are both
-    /// inside holds every pixel and one whose both are outside holds none: only the edges that
-    /// cross the row are stepped pixel by pixel (the same values and tests as stepping all
-    /// three, so the same bits).
+    /// inside holds every pixel and one whose both are outside holds none; an edge that crosses
+    /// the row holds a prefix or a suffix of it, found by an exact integer division (the same
+    /// pixels as testing each one's value, so the same bits).
     #[inline]
     fn row_bits(&self, row: [i64; 3], x0: i32, x1: i32) -> u64 {
         let n = x1 - x0;
@@ -372,14 +372,18 @@ impl EdgeStepper {
             match (first >= 0, last >= 0) {
                 (true, true) => {}
                 (false, false) => return 0,
+                // The edge crosses the row (so `step` is not 0): its inside pixels are a suffix
+                // of the row where it grows and a prefix where it falls, bounded by one exact
+                // integer division instead of a test per pixel.
+                _ if step > 0 => {
+                    // first < 0 ≤ last: inside from k0 = ⌈−first / step⌉ (1 ≤ k0 ≤ n − 1) on.
+                    let k0 = (step - 1 - first) / step;
+                    bits &= !((1u64 << k0) - 1);
+                }
                 _ => {
-                    let mut v = first;
-                    let mut edge_bits = 0u64;
-                    for k in 0..n {
-                        edge_bits |= ((v >= 0) as u64) << k;
-                        v += step;
-                    }
-                    bits &= edge_bits;
+                    // first ≥ 0 > last: inside up to k1 = ⌊first / −step⌋ (0 ≤ k1 ≤ n − 2).
+                    let k1 = first / -step;
+                    bits &= (2u64 << k1) - 1;
                 }
             }
         }
@@ -637,6 +641,50 @@ mod tests {
         rasterize(tri, rect, strategy, |x, y| out.push((x, y)));
         out.sort_unstable();
         out
+    }
+
+    /// `row_bits` (a division per crossing edge) against testing every pixel's stepped value,
+    /// over rows of every length, crossings at every position and steps of both signs,
+    /// including values and steps near the fixed-point bound.
+    #[test]
+    fn row_bits_match_per_pixel_tests() {
+        let per_pixel = |row: [i64; 3], step_x: [i64; 3], n: i32| {
+            let mut bits = 0u64;
+            for k in 0..n as i64 {
+                if (0..3).all(|e| row[e] + step_x[e] * k >= 0) {
+                    bits |= 1 << k;
+                }
+            }
+            bits
+        };
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        for case in 0..20_000 {
+            let n = 1 + (next() % 64) as i32;
+            // Small steps cross within the row; large ones (up to 2^40) test the division at
+            // the scale of big triangles' edge values.
+            let scale = if case % 2 == 0 { 1 << 10 } else { 1i64 << 40 };
+            let step_x: [i64; 3] = std::array::from_fn(|_| (next() as i64) % scale);
+            let row: [i64; 3] = std::array::from_fn(|e| {
+                let crossing = (next() % (n as u64 + 2)) as i64 - 1;
+                -step_x[e] * crossing + (next() as i64) % (step_x[e].abs() + 1)
+            });
+            let stepper = EdgeStepper {
+                value: row,
+                step_x,
+                step_y: [0; 3],
+            };
+            assert_eq!(
+                stepper.row_bits(row, 0, n),
+                per_pixel(row, step_x, n),
+                "row {row:?}, steps {step_x:?}, {n} pixels"
+            );
+        }
     }
 
     #[test]
