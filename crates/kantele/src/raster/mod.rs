@@ -278,56 +278,56 @@ pub fn prefers_blocks(tri: &TriangleSetup) -> bool {
     2 * h <= 5 * w && 5 * w <= 8 * h
 }
 
-/// Coverage bits of pixels scanned one by one, gathered per block of the tile.
-struct TileMasks {
-    masks: [u64; 64],
-}
+// A row of a tile is one `u64` of coverage bits.
+const _: () = assert!(TILE_SIZE <= 64);
 
-impl TileMasks {
-    fn new() -> Self {
-        Self { masks: [0; 64] }
-    }
-
-    #[inline]
-    fn set(&mut self, x: i32, y: i32) {
-        let block = (((y >> BLOCK_LOG2) & 7) << 3) | ((x >> BLOCK_LOG2) & 7);
-        self.masks[block as usize] |= 1u64 << (((y & 7) << 3) | (x & 7));
-    }
-
-    /// Appends the non-empty blocks of `rect` (which lies in one tile).
-    fn emit(&self, rect: PixelRect, out: &mut BlockCoverage) {
-        let (tx, ty) = (
-            rect.x0 & !(TILE_SIZE as i32 - 1),
-            rect.y0 & !(TILE_SIZE as i32 - 1),
-        );
-        let (bx0, bx1) = (
-            (rect.x0 - tx) >> BLOCK_LOG2,
-            ((rect.x1 - 1 - tx) >> BLOCK_LOG2) + 1,
-        );
-        let (by0, by1) = (
-            (rect.y0 - ty) >> BLOCK_LOG2,
-            ((rect.y1 - 1 - ty) >> BLOCK_LOG2) + 1,
-        );
-        for by in by0..by1 {
-            for bx in bx0..bx1 {
-                let mask = self.masks[(by * 8 + bx) as usize];
-                out.push(tx + (bx << BLOCK_LOG2), ty + (by << BLOCK_LOG2), mask);
+/// Appends the coverage of `rect` (which lies in one tile) given row by row: `row_bits(y)` is
+/// row `y`'s bits (bit `k` = pixel `rect.x0 + k`), asked for in order from `rect.y0`. Works one
+/// block row (8 pixel rows) at a time: a row's bits go into that block row's masks a byte per
+/// block, and its non-empty blocks are appended (row-major) before the next block row, so a
+/// small triangle clears and visits only the one or two blocks it touches.
+#[inline]
+fn scan_rows(rect: PixelRect, out: &mut BlockCoverage, mut row_bits: impl FnMut(i32) -> u64) {
+    let block = BLOCK_SIZE as i32;
+    let tile_x = rect.x0 & !(TILE_SIZE as i32 - 1);
+    // The rectangle's block columns, counted from the tile's left edge.
+    let (bx0, bx1) = (
+        ((rect.x0 - tile_x) >> BLOCK_LOG2) as usize,
+        (((rect.x1 - 1 - tile_x) >> BLOCK_LOG2) + 1) as usize,
+    );
+    // Bit `c` of a row's bits shifted by this = tile column `c` (the rectangle lies in the
+    // tile, so nothing is shifted out).
+    let column_shift = (rect.x0 - tile_x) as u32;
+    let mut y = rect.y0;
+    while y < rect.y1 {
+        let block_y = y & !(block - 1);
+        let band_end = (block_y + block).min(rect.y1);
+        let mut masks = [0u64; (TILE_SIZE / BLOCK_SIZE) as usize];
+        for y in y..band_end {
+            let mut bits = row_bits(y) << column_shift;
+            let shift = ((y & (block - 1)) << BLOCK_LOG2) as u32;
+            while bits != 0 {
+                let bx = (bits.trailing_zeros() >> BLOCK_LOG2) as usize;
+                let first = (bx as u32) << BLOCK_LOG2;
+                masks[bx] |= ((bits >> first) & 0xff) << shift;
+                bits &= !(0xffu64 << first);
             }
         }
+        for (bx, &mask) in masks.iter().enumerate().take(bx1).skip(bx0) {
+            out.push(tile_x + ((bx as i32) << BLOCK_LOG2), block_y, mask);
+        }
+        y = band_end;
     }
 }
 
 /// The simplest scan: every pixel of the box, every edge evaluated from scratch.
 fn scan_bounding_box(tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverage) {
-    let mut masks = TileMasks::new();
-    for y in rect.y0..rect.y1 {
-        for x in rect.x0..rect.x1 {
-            if tri.covers(x, y) {
-                masks.set(x, y);
-            }
-        }
-    }
-    masks.emit(rect, out);
+    scan_rows(rect, out, |y| {
+        (rect.x0..rect.x1)
+            .enumerate()
+            .filter(|&(_, x)| tri.covers(x, y))
+            .fold(0u64, |bits, (k, _)| bits | 1 << k)
+    });
 }
 
 /// Biased edge values at the centre of pixel `(x, y)` and their per-pixel steps.
@@ -401,52 +401,18 @@ impl EdgeStepper {
     }
 }
 
-// A row of a tile is one `u64` of coverage bits.
-const _: () = assert!(TILE_SIZE <= 64);
-
-/// Bounding-box scan with incremental edge functions: one add per edge per pixel.
-///
-/// Works one block row (8 pixel rows) at a time: the row's coverage bits go into the masks of
-/// that block row's blocks a block's byte at a time, and the block row's non-empty blocks are
-/// appended before the next is scanned (row-major, as [`TileMasks::emit`] orders them). Small
-/// triangles, this strategy's usual work, touch one or two blocks: nothing is cleared or
-/// visited for the rest of the tile.
+/// Bounding-box scan with incremental edge functions: each row's values stepped by one add per
+/// edge from the row above ([`EdgeStepper::row_bits`] within the row).
 fn scan_incremental(tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverage) {
     let stepper = EdgeStepper::at(tri, rect.x0, rect.y0);
-    let block = BLOCK_SIZE as i32;
-    let tile_x = rect.x0 & !(TILE_SIZE as i32 - 1);
-    // The rectangle's block columns, counted from the tile's left edge.
-    let (bx0, bx1) = (
-        ((rect.x0 - tile_x) >> BLOCK_LOG2) as usize,
-        (((rect.x1 - 1 - tile_x) >> BLOCK_LOG2) + 1) as usize,
-    );
-    // Bit `c` of a row's bits shifted by this = tile column `c` (the rectangle lies in the
-    // tile, so nothing is shifted out).
-    let column_shift = (rect.x0 - tile_x) as u32;
     let mut row = stepper.value;
-    let mut y = rect.y0;
-    while y < rect.y1 {
-        let block_y = y & !(block - 1);
-        let band_end = (block_y + block).min(rect.y1);
-        let mut masks = [0u64; (TILE_SIZE / BLOCK_SIZE) as usize];
-        for y in y..band_end {
-            let mut bits = stepper.row_bits(row, rect.x0, rect.x1) << column_shift;
-            let shift = ((y & (block - 1)) << BLOCK_LOG2) as u32;
-            while bits != 0 {
-                let bx = (bits.trailing_zeros() >> BLOCK_LOG2) as usize;
-                let first = (bx as u32) << BLOCK_LOG2;
-                masks[bx] |= ((bits >> first) & 0xff) << shift;
-                bits &= !(0xffu64 << first);
-            }
-            row[0] += stepper.step_y[0];
-            row[1] += stepper.step_y[1];
-            row[2] += stepper.step_y[2];
-        }
-        for (bx, &mask) in masks.iter().enumerate().take(bx1).skip(bx0) {
-            out.push(tile_x + ((bx as i32) << BLOCK_LOG2), block_y, mask);
-        }
-        y = band_end;
-    }
+    scan_rows(rect, out, |_| {
+        let bits = stepper.row_bits(row, rect.x0, rect.x1);
+        row[0] += stepper.step_y[0];
+        row[1] += stepper.step_y[1];
+        row[2] += stepper.step_y[2];
+        bits
+    });
 }
 
 /// How a block relates to the triangle, judged by the edge values at its corner pixels.
