@@ -17,7 +17,7 @@ use super::shader::{vertex_varyings, FragmentLanes, Interpolation, Shader};
 use crate::fixed::pixel_center;
 use crate::raster::bin::{TileBins, TriangleRef};
 use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
-use crate::rop::{BlendMode, BlockRows, Framebuffer, TileBuffer};
+use crate::rop::{BlendMode, BlockRows, DeferredClear, Framebuffer, TileBuffer};
 use crate::setup::TriangleSetup;
 use crate::simd::{dispatch, prefetch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
 
@@ -97,7 +97,8 @@ pub(super) fn raster_tiles(
                     continue;
                 }
                 let attrs = geometry.attrs(t);
-                tile.materialize();
+                // No `materialize`: the per-pixel path writes each block's pending clear
+                // together with the first triangle that reaches the block.
                 let c = draw.raster(tri, attrs, &coverage, tile, isa);
                 counters = RasterCounters::sum(counters, c);
             }
@@ -243,6 +244,29 @@ impl<L: Lanes> TriangleLanes<L> {
     }
 }
 
+/// A tile's deferred clear ([`DeferredClear`]) splatted across the lanes.
+struct ClearLanes<L: Lanes> {
+    color: [L::F32; 4],
+    depth: L::F32,
+}
+
+impl<L: Lanes> ClearLanes<L> {
+    /// `clear` across the lanes (`None` stays `None`; no closure: see [`crate::simd`]).
+    #[inline(always)]
+    fn splat(lanes: L, clear: Option<DeferredClear>) -> Option<Self> {
+        let clear = clear?;
+        Some(Self {
+            color: [
+                lanes.splat_f32(clear.color.x),
+                lanes.splat_f32(clear.color.y),
+                lanes.splat_f32(clear.color.z),
+                lanes.splat_f32(clear.color.w),
+            ],
+            depth: lanes.splat_f32(clear.depth),
+        })
+    }
+}
+
 /// One triangle in one tile, as a kernel compiled per instruction set.
 struct ShadeTriangle<'k, 'a, S: Shader> {
     draw: &'k DrawCall<'a, S>,
@@ -297,6 +321,10 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                 continue;
             }
             counters.covered += block.mask.count_ones() as u64;
+            // The tile's clear, when this block's storage does not hold it yet: every row of the
+            // block is then stored whole, the clear where this triangle writes nothing, so the
+            // clear is written once, together with the triangle, and never read back.
+            let pending = ClearLanes::splat(lanes, tile.take_pending_block(block_index));
             // Lanes shaded and lanes kept, row by row (bit `8·row + lane`): counted once per
             // block, not per row.
             let mut shaded_bits = 0u64;
@@ -304,74 +332,111 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
             let columns = triangle.column_terms(lanes, pixel_center(block.x as i64) - v0x);
             let mut rows = tile.block_rows_mut(TileBuffer::index(block.x, block.y));
             for row in 0..8 {
-                let row_bits = (block.mask >> (8 * row)) as u8;
-                if row_bits == 0 {
-                    continue;
-                }
-                let (x, y) = (block.x, block.y + row as i32);
                 let at = BlockRows::row_offset(row);
-                let bary =
-                    triangle.barycentrics_in_row(lanes, &columns, pixel_center(y as i64) - v0y);
-                let depth = triangle.depth(bary);
-                let mut active = lanes.mask_from_bits(row_bits);
-                if depth_needs_range_test {
-                    // Outside [0, 1] (or NaN): beyond the near or far plane.
-                    active = active.and(depth.simd_ge(zero)).and(depth.simd_le(one));
-                }
-                if state.depth_test {
-                    let stored = lanes.load_f32(&rows.depth[at..at + 8]);
-                    active = active.and(state.depth_func.passes_lanes(lanes, depth, stored));
-                }
-                let active_bits = active.bits();
-                if active_bits == 0 {
-                    continue;
-                }
-                shaded_bits |= (active_bits as u64) << (8 * row);
-                let (weights, w) = triangle.perspective_weights(bary);
-                let fragments = FragmentLanes {
-                    lanes,
-                    x: x as u32,
-                    y: y as u32,
-                    active,
-                    depth,
-                    primitive_id: tri.primitive_id,
-                    front_facing: tri.front_facing(),
-                    weights,
-                    w,
-                    interpolation: &interpolation,
-                };
-                let shaded = shader.fragment_lanes(&fragments);
-                let keep = active.and(shaded.keep);
-                let keep_bits = keep.bits();
-                if keep_bits == 0 {
-                    continue;
-                }
-                kept_bits |= (keep_bits as u64) << (8 * row);
-                // NaN channels are written as 0 and counted, before and after blending
-                // (blending infinities can make NaN) (robust branch).
-                let (src, nan_src) = zero_nan_channels(lanes, shaded.color, keep);
-                counters.nan_channels += nan_src;
-                let blended = if blend_reads_target {
-                    let dst = [
-                        lanes.load_f32(&rows.color[0][at..at + 8]),
-                        lanes.load_f32(&rows.color[1][at..at + 8]),
-                        lanes.load_f32(&rows.color[2][at..at + 8]),
-                        lanes.load_f32(&rows.color[3][at..at + 8]),
-                    ];
-                    let blended = state.blend.blend_lanes(lanes, src, dst);
-                    let (blended, nan_blended) = zero_nan_channels(lanes, blended, keep);
-                    counters.nan_channels += nan_blended;
-                    blended
-                } else {
-                    src
+                let written = 'row: {
+                    let row_bits = (block.mask >> (8 * row)) as u8;
+                    if row_bits == 0 {
+                        break 'row None;
+                    }
+                    let (x, y) = (block.x, block.y + row as i32);
+                    let bary =
+                        triangle.barycentrics_in_row(lanes, &columns, pixel_center(y as i64) - v0y);
+                    let depth = triangle.depth(bary);
+                    let mut active = lanes.mask_from_bits(row_bits);
+                    if depth_needs_range_test {
+                        // Outside [0, 1] (or NaN): beyond the near or far plane.
+                        active = active.and(depth.simd_ge(zero)).and(depth.simd_le(one));
+                    }
+                    if state.depth_test {
+                        let stored = match &pending {
+                            Some(clear) => clear.depth,
+                            None => lanes.load_f32(&rows.depth[at..at + 8]),
+                        };
+                        active = active.and(state.depth_func.passes_lanes(lanes, depth, stored));
+                    }
+                    let active_bits = active.bits();
+                    if active_bits == 0 {
+                        break 'row None;
+                    }
+                    shaded_bits |= (active_bits as u64) << (8 * row);
+                    let (weights, w) = triangle.perspective_weights(bary);
+                    let fragments = FragmentLanes {
+                        lanes,
+                        x: x as u32,
+                        y: y as u32,
+                        active,
+                        depth,
+                        primitive_id: tri.primitive_id,
+                        front_facing: tri.front_facing(),
+                        weights,
+                        w,
+                        interpolation: &interpolation,
+                    };
+                    let shaded = shader.fragment_lanes(&fragments);
+                    let keep = active.and(shaded.keep);
+                    let keep_bits = keep.bits();
+                    if keep_bits == 0 {
+                        break 'row None;
+                    }
+                    kept_bits |= (keep_bits as u64) << (8 * row);
+                    // NaN channels are written as 0 and counted, before and after blending
+                    // (blending infinities can make NaN) (robust branch).
+                    let (src, nan_src) = zero_nan_channels(lanes, shaded.color, keep);
+                    counters.nan_channels += nan_src;
+                    let blended = if blend_reads_target {
+                        let dst = match &pending {
+                            Some(clear) => clear.color,
+                            None => [
+                                lanes.load_f32(&rows.color[0][at..at + 8]),
+                                lanes.load_f32(&rows.color[1][at..at + 8]),
+                                lanes.load_f32(&rows.color[2][at..at + 8]),
+                                lanes.load_f32(&rows.color[3][at..at + 8]),
+                            ],
+                        };
+                        let blended = state.blend.blend_lanes(lanes, src, dst);
+                        let (blended, nan_blended) = zero_nan_channels(lanes, blended, keep);
+                        counters.nan_channels += nan_blended;
+                        blended
+                    } else {
+                        src
+                    };
+                    Some((blended, depth, keep))
                 };
                 let [r, g, b, a] = &mut rows.color;
-                blended[0].store_masked(keep, &mut r[at..at + 8]);
-                blended[1].store_masked(keep, &mut g[at..at + 8]);
-                blended[2].store_masked(keep, &mut b[at..at + 8]);
-                blended[3].store_masked(keep, &mut a[at..at + 8]);
-                if state.depth_write {
-                    depth.store_masked(keep, &mut rows.depth[at..at + 8]);
+                match (written, &pending) {
+                    (Some((color, depth, keep)), None) => {
+                        color[0].store_masked(keep, &mut r[at..at + 8]);
+                        color[1].store_masked(keep, &mut g[at..at + 8]);
+                        color[2].store_masked(keep, &mut b[at..at + 8]);
+                        color[3].store_masked(keep, &mut a[at..at + 8]);
+                        if state.depth_write {
+                            depth.store_masked(keep, &mut rows.depth[at..at + 8]);
+                        }
+                    }
+                    (Some((color, depth, keep)), Some(clear)) => {
+                        keep.select_f32(color[0], clear.color[0])
+                            .store(&mut r[at..at + 8]);
+                        keep.select_f32(color[1], clear.color[1])
+                            .store(&mut g[at..at + 8]);
+                        keep.select_f32(color[2], clear.color[2])
+                            .store(&mut b[at..at + 8]);
+                        keep.select_f32(color[3], clear.color[3])
+                            .store(&mut a[at..at + 8]);
+                        let depth = if state.depth_write {
+                            keep.select_f32(depth, clear.depth)
+                        } else {
+                            clear.depth
+                        };
+                        depth.store(&mut rows.depth[at..at + 8]);
+                    }
+                    (None, Some(clear)) => {
+                        clear.color[0].store(&mut r[at..at + 8]);
+                        clear.color[1].store(&mut g[at..at + 8]);
+                        clear.color[2].store(&mut b[at..at + 8]);
+                        clear.color[3].store(&mut a[at..at + 8]);
+                        clear.depth.store(&mut rows.depth[at..at + 8]);
+                    }
+                    (None, None) => {}
                 }
             }
             let shaded_count = shaded_bits.count_ones() as u64;

@@ -11,7 +11,7 @@ pub use crate::state::{BlendMode, DepthFunc};
 
 mod tile;
 
-pub use tile::{BlockRows, TileBuffer, BLOCK_SPAN};
+pub use tile::{BlockRows, DeferredClear, TileBuffer, BLOCK_SPAN};
 
 use crate::error::RenderError;
 use crate::fixed::{TILE_LOG2, TILE_PIXELS, TILE_SIZE};
@@ -365,6 +365,61 @@ mod tests {
             assert!(written.1.iter().all(|&d| d == 0.375));
             assert_eq!(fb.depth_at(69, 2), Some(0.375));
         }
+    }
+
+    /// A block taken from a deferred clear reads back what was written into it, every other
+    /// pixel the clear, before and after the rest of the clear is written out; a block is
+    /// handed out once.
+    #[test]
+    fn blocks_taken_from_a_deferred_clear_read_back_their_own_values() {
+        let mut fb = Framebuffer::new(130, 70, SampleCount::X1).expect("small target");
+        let color = Vec4::new(0.1, 0.7, 1.0 / 3.0, 0.9);
+        fb.clear(Some(color), Some(0.375));
+        // Tile 0's block 9 (pixels x 8..16, y 8..16) and tile 1's block 0 (x 64..72, y 0..8).
+        let taken = [(0, 9, 8, 8), (1, 0, 64, 0)];
+        for (tile, block, x, y) in taken {
+            let tile = &mut fb.tiles_mut()[tile];
+            let clear = tile
+                .take_pending_block(block)
+                .expect("pending after a clear");
+            assert_eq!((clear.color, clear.depth), (color, 0.375));
+            assert!(tile.take_pending_block(block).is_none(), "handed out twice");
+            let mut rows = tile.block_rows_mut(TileBuffer::index(x, y));
+            for row in 0..8 {
+                let at = BlockRows::row_offset(row);
+                rows.depth[at..at + 8].fill(0.25);
+                for plane in rows.color.iter_mut() {
+                    plane[at..at + 8].fill(0.5);
+                }
+            }
+        }
+        let in_taken = |x: u32, y: u32| {
+            taken.iter().any(|&(_, _, bx, by)| {
+                (bx as u32..bx as u32 + 8).contains(&x) && (by as u32..by as u32 + 8).contains(&y)
+            })
+        };
+        let expected: Vec<(Vec4, f32)> = (0..70u32)
+            .flat_map(|y| (0..130u32).map(move |x| (x, y)))
+            .map(|(x, y)| match in_taken(x, y) {
+                true => (Vec4::splat(0.5), 0.25),
+                false => (color, 0.375),
+            })
+            .collect();
+        let read = |fb: &Framebuffer| -> Vec<(Vec4, f32)> {
+            let colors = fb.read_color();
+            let depths = fb.read_depth();
+            colors
+                .into_iter()
+                .zip(depths)
+                .map(|(c, d)| (Vec4::from_array(c), d))
+                .collect()
+        };
+        assert_eq!(read(&fb), expected, "deferred");
+        for tile in fb.tiles_mut() {
+            tile.materialize();
+            assert!(tile.take_pending_block(3).is_none());
+        }
+        assert_eq!(read(&fb), expected, "written out");
     }
 
     /// Clearing only colour or only depth keeps the other from the clear before it, deferred

@@ -35,20 +35,35 @@ pub struct TileBuffer {
     /// The largest depth of each 8 × 8 block (row-major blocks of the tile), kept exact by the
     /// per-pixel path after every block it writes: the second level of the depth hierarchy.
     block_depth_max: [f32; BLOCKS_PER_TILE],
-    /// A clear not yet written to the storage: while set, every pixel and sample of the tile
-    /// holds this colour and depth, whatever `color` and `depth` contain. Clearing a frame only
-    /// sets it; the first triangle that reaches the tile writes it out
-    /// ([`TileBuffer::materialize`]), in the thread that rasterizes the tile, so the tile is
-    /// in cache for its triangles, and a tile that no triangle reaches is never written.
+    /// A clear not yet written to (some blocks of) the storage: while set, every pixel and
+    /// sample of a block in its `pending` set holds this colour and depth, whatever `color` and
+    /// `depth` contain. Clearing a frame only records it. At 1× the per-pixel path writes a
+    /// pending block's clear together with the first triangle that reaches the block
+    /// ([`TileBuffer::take_pending_block`]: every pixel of the block is stored once, the
+    /// triangle's where it wrote, the clear elsewhere); other paths write all pending blocks
+    /// first ([`TileBuffer::materialize`]). A block that no triangle reaches is never written.
     deferred_clear: Option<DeferredClear>,
 }
 
-/// The values of a clear that a tile has not written to its storage yet.
-#[derive(Clone, Copy, Debug)]
-struct DeferredClear {
-    color: Vec4,
-    depth: f32,
+/// The values of a clear that some blocks of a tile have not written to the storage yet.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeferredClear {
+    /// Linear colour of every sample.
+    pub color: Vec4,
+    /// Window depth of every depth plane.
+    pub depth: f32,
+    /// The blocks (bit `b` for block `b`, row-major blocks of the tile) whose storage does not
+    /// hold their values yet; never 0 while the clear is recorded.
+    pending: u64,
 }
+
+const _: () = assert!(
+    BLOCKS_PER_TILE == 64,
+    "one bit of DeferredClear::pending per block"
+);
+
+/// Every block of a tile pending.
+const ALL_BLOCKS: u64 = u64::MAX;
 
 /// Pixels from the first of an 8 × 8 block to its last, in a tile's row-major order: seven
 /// tile rows and one block row.
@@ -121,7 +136,7 @@ impl TileBuffer {
     /// bounds checks.
     #[inline(always)]
     pub fn block_rows_mut(&mut self, first: usize) -> BlockRows<'_> {
-        self.debug_assert_materialized();
+        self.debug_assert_block_written(first);
         debug_assert_eq!(self.samples, 1);
         let (r, rest) = self.color.split_at_mut(TILE_PIXELS);
         let (g, rest) = rest.split_at_mut(TILE_PIXELS);
@@ -233,8 +248,8 @@ impl TileBuffer {
         // A deferred clear resolves through the same sum and division as stored samples, so it
         // reads back bit for bit as a written one.
         match self.deferred_clear {
-            Some(clear) => self.resolve(|c, _| clear.color[c]),
-            None => {
+            Some(clear) if clear.holds(index) => self.resolve(|c, _| clear.color[c]),
+            _ => {
                 let plane = self.samples * TILE_PIXELS;
                 self.resolve(|c, s| self.color[c * plane + s * TILE_PIXELS + index])
             }
@@ -261,19 +276,56 @@ impl TileBuffer {
     #[inline]
     pub fn depth_at(&self, index: usize) -> f32 {
         match self.deferred_clear {
-            Some(clear) => clear.depth,
-            None => self.depth[index],
+            Some(clear) if clear.holds(index) => clear.depth,
+            _ => self.depth[index],
         }
     }
 
-    /// Writes a deferred clear to the storage (nothing when none is pending). The per-pixel
-    /// paths call it before they touch the tile's colour or depth.
+    /// Writes a deferred clear to the storage of every block still pending (nothing when none
+    /// is). Paths that touch the tile's storage other than block by block
+    /// ([`TileBuffer::take_pending_block`]) call it first.
     #[inline]
     pub(crate) fn materialize(&mut self) {
-        if let Some(clear) = self.deferred_clear.take() {
+        let Some(clear) = self.deferred_clear.take() else {
+            return;
+        };
+        if clear.pending == ALL_BLOCKS {
             self.write_color(clear.color);
             self.depth.fill(clear.depth);
+            return;
         }
+        let mut pending = clear.pending;
+        while pending != 0 {
+            let first = block_first_pixel(pending.trailing_zeros() as usize);
+            pending &= pending - 1;
+            // Colour plane `c·N + s` holds channel `c` of sample `s`.
+            for (k, plane) in self.color.chunks_exact_mut(TILE_PIXELS).enumerate() {
+                fill_block(plane, first, clear.color[k / self.samples]);
+            }
+            for plane in self.depth.chunks_exact_mut(TILE_PIXELS) {
+                fill_block(plane, first, clear.depth);
+            }
+        }
+    }
+
+    /// The recorded clear when block `block` (1× tiles) does not hold it in the storage yet; the
+    /// block then counts as written, and the caller must store every pixel of the block's
+    /// colour and depth (the clear's values where it draws nothing). `None` when the storage
+    /// holds the block's values.
+    #[inline(always)]
+    pub fn take_pending_block(&mut self, block: usize) -> Option<DeferredClear> {
+        debug_assert_eq!(self.samples, 1);
+        let clear = self.deferred_clear.as_mut()?;
+        let bit = 1u64 << block;
+        if clear.pending & bit == 0 {
+            return None;
+        }
+        let taken = *clear;
+        clear.pending &= !bit;
+        if clear.pending == 0 {
+            self.deferred_clear = None;
+        }
+        Some(taken)
     }
 
     /// Sets every sample's colour in the storage.
@@ -290,6 +342,15 @@ impl TileBuffer {
         debug_assert!(
             self.deferred_clear.is_none(),
             "tile storage used before materialize"
+        );
+    }
+
+    /// Panics (debug builds) if the block holding tile index `first` still has a pending clear.
+    #[inline(always)]
+    fn debug_assert_block_written(&self, first: usize) {
+        debug_assert!(
+            self.deferred_clear.is_none_or(|clear| !clear.holds(first)),
+            "block storage used before its pending clear was taken"
         );
     }
 
@@ -328,7 +389,11 @@ impl TileBuffer {
     pub(super) fn fill(&mut self, color: Option<Vec4>, depth: Option<f32>) {
         match (color, depth) {
             (Some(color), Some(depth)) => {
-                self.deferred_clear = Some(DeferredClear { color, depth })
+                self.deferred_clear = Some(DeferredClear {
+                    color,
+                    depth,
+                    pending: ALL_BLOCKS,
+                })
             }
             _ => {
                 self.materialize();
@@ -373,9 +438,11 @@ impl TileBuffer {
     /// gives its exact maximum, kept by the per-pixel paths, so only blocks cut by the
     /// target's edge are read pixel by pixel: 64 values instead of 4096 for an inner tile.
     fn exact_depth_bound(&self, tile: &PixelRect) -> f32 {
-        if let Some(clear) = self.deferred_clear {
-            return clear.depth;
-        }
+        let pending = match self.deferred_clear {
+            Some(clear) if clear.pending == ALL_BLOCKS => return clear.depth,
+            Some(clear) => Some(clear),
+            None => None,
+        };
         let block = BLOCK_SIZE as i32;
         let mut bound = f32::NEG_INFINITY;
         for by in 0..(TILE_SIZE as i32 / block) {
@@ -390,8 +457,13 @@ impl TileBuffer {
                 if x0 >= x1 {
                     break;
                 }
+                let block_index = Self::block_index(x0, y0);
                 if y1 - y0 == block && x1 - x0 == block {
-                    bound = bound.max(self.block_depth_max[Self::block_index(x0, y0)]);
+                    bound = bound.max(self.block_depth_max[block_index]);
+                    continue;
+                }
+                if let Some(clear) = pending.filter(|c| c.pending & (1 << block_index) != 0) {
+                    bound = bound.max(clear.depth);
                     continue;
                 }
                 for plane in self.depth.chunks_exact(TILE_PIXELS) {
@@ -415,6 +487,38 @@ impl TileBuffer {
         let mask = TILE_SIZE as i32 - 1;
         (((y & mask) << TILE_LOG2) | (x & mask)) as usize
     }
+}
+
+impl DeferredClear {
+    /// Whether the pixel at tile index `index` lies in a pending block.
+    #[inline(always)]
+    fn holds(&self, index: usize) -> bool {
+        self.pending & (1u64 << block_of_index(index)) != 0
+    }
+}
+
+/// The block (row-major blocks of the tile) holding tile index `index`.
+#[inline(always)]
+fn block_of_index(index: usize) -> usize {
+    let blocks_log2 = (TILE_LOG2 - BLOCK_LOG2) as usize;
+    let (x, y) = (index & (TILE_SIZE as usize - 1), index >> TILE_LOG2);
+    ((y >> BLOCK_LOG2) << blocks_log2) | (x >> BLOCK_LOG2)
+}
+
+/// Sets the 8 × 8 block of `plane` (one tile plane) whose first pixel is `first` to `value`.
+fn fill_block(plane: &mut [f32], first: usize, value: f32) {
+    for row in 0..BLOCK_SIZE as usize {
+        let at = first + row * TILE_SIZE as usize;
+        plane[at..at + BLOCK_SIZE as usize].fill(value);
+    }
+}
+
+/// Tile index of the first pixel of block `block`.
+#[inline(always)]
+fn block_first_pixel(block: usize) -> usize {
+    let blocks_log2 = (TILE_LOG2 - BLOCK_LOG2) as usize;
+    let (bx, by) = (block & ((1 << blocks_log2) - 1), block >> blocks_log2);
+    ((by << BLOCK_LOG2) << TILE_LOG2) | (bx << BLOCK_LOG2)
 }
 
 /// A vector of `n` copies of `value`, or an error instead of an abort when memory runs out.
