@@ -63,8 +63,14 @@ impl Texture {
             ColorSpace::Srgb => Some(decode_table(ColorSpace::Srgb)),
             ColorSpace::Linear => None,
         };
-        let lod = self.lod_lanes::<L>(duv_dx, duv_dy);
-        let selection = LevelSelection::<L>::new(self, sampler, lod);
+        let rho2 = self.footprint_lanes::<L>(duv_dx, duv_dy);
+        // λ ≤ 0 exactly where ρ² ≤ 1 (see `log2_normal`), so when every live lane is magnified
+        // the level of detail is not needed: level 0, no blend.
+        let selection = if rho2.simd_le(lanes.splat_f32(1.0)).or(live.not()).all() {
+            LevelSelection::<L>::magnified(lanes, sampler)
+        } else {
+            LevelSelection::<L>::new(self, sampler, self.lod_lanes::<L>(rho2))
+        };
         let nearest = selection.nearest;
         let first = self.sample_level_lanes::<L>(sampler, srgb, selection.first, uv, nearest, live);
         // The second level only where some live lane blends (trilinear between levels).
@@ -94,10 +100,10 @@ impl Texture {
         texel
     }
 
-    /// Per-lane level of detail `λ = ½ log2 ρ²` ([`Texture::lod`]): `−∞` where the footprint is
-    /// zero (or below the smallest normal float), the last level where it is not finite.
+    /// Per-lane squared footprint `ρ² = max(|∂uv/∂x|², |∂uv/∂y|²)` in texels of level 0
+    /// ([`Texture::lod`]).
     #[inline(always)]
-    fn lod_lanes<L: Lanes>(&self, duv_dx: [L::F32; 2], duv_dy: [L::F32; 2]) -> L::F32 {
+    fn footprint_lanes<L: Lanes>(&self, duv_dx: [L::F32; 2], duv_dy: [L::F32; 2]) -> L::F32 {
         let lanes = duv_dx[0].lanes();
         let width = lanes.splat_f32(self.width() as f32);
         let height = lanes.splat_f32(self.height() as f32);
@@ -107,7 +113,15 @@ impl Texture {
         );
         // `f32::max` ignores a NaN operand; the lane `max` returns `ry` when either is NaN.
         let ry_is_nan = ry.simd_ne(ry);
-        let rho2 = ry_is_nan.select_f32(rx, rx.max(ry));
+        ry_is_nan.select_f32(rx, rx.max(ry))
+    }
+
+    /// Per-lane level of detail `λ = ½ log2 ρ²` ([`Texture::lod`]) from the squared footprint
+    /// ([`Texture::footprint_lanes`]): `−∞` where it is zero (or below the smallest normal
+    /// float), the last level where it is not finite.
+    #[inline(always)]
+    fn lod_lanes<L: Lanes>(&self, rho2: L::F32) -> L::F32 {
+        let lanes = rho2.lanes();
         let normal = rho2
             .simd_ge(lanes.splat_f32(f32::MIN_POSITIVE))
             .and(rho2.simd_lt(lanes.splat_f32(f32::INFINITY)));
@@ -160,31 +174,30 @@ impl Texture {
         let x1 = sampler.wrap_s.wrap_lanes::<L>(i0 + one, width);
         let row0 = offset + sampler.wrap_t.wrap_lanes::<L>(j0, height) * width;
         let row1 = offset + sampler.wrap_t.wrap_lanes::<L>(j0 + one, height) * width;
+        let (one_alpha, one_beta) = (lanes.splat_f32(1.0) - alpha, lanes.splat_f32(1.0) - beta);
+        // Each row's two texels are blended as soon as they are fetched, so only one row's
+        // texels are live at a time (four texels of four channels would not fit the registers).
         // Where every live lane's two columns are neighbours in memory (no wrap between them,
         // the common case), each row's pair of texels is one 8-byte read per lane.
         let neighbours = x1.simd_eq(x0 + one).or(live.not()).all();
-        let (t00, t10, t01, t11) = if neighbours {
+        let (top, bottom) = if neighbours {
             let (t00, t10) = self.fetch_pair_lanes::<L>(srgb, row0 + x0);
+            let top = lerp_channels::<L>(&t00, &t10, one_alpha, alpha);
             let (t01, t11) = self.fetch_pair_lanes::<L>(srgb, row1 + x0);
-            (t00, t10, t01, t11)
+            (top, lerp_channels::<L>(&t01, &t11, one_alpha, alpha))
         } else {
-            (
+            let (t00, t10) = (
                 self.fetch_lanes::<L>(srgb, row0 + x0),
                 self.fetch_lanes::<L>(srgb, row0 + x1),
+            );
+            let top = lerp_channels::<L>(&t00, &t10, one_alpha, alpha);
+            let (t01, t11) = (
                 self.fetch_lanes::<L>(srgb, row1 + x0),
                 self.fetch_lanes::<L>(srgb, row1 + x1),
-            )
+            );
+            (top, lerp_channels::<L>(&t01, &t11, one_alpha, alpha))
         };
-        let (one_alpha, one_beta) = (lanes.splat_f32(1.0) - alpha, lanes.splat_f32(1.0) - beta);
-        // Plain loops, not closures: a closure would be compiled without the instruction set's
-        // target feature and call the lane operations out of line.
-        let mut texel = t00;
-        for c in 0..4 {
-            let top = t00[c] * one_alpha + t10[c] * alpha;
-            let bottom = t01[c] * one_alpha + t11[c] * alpha;
-            texel[c] = top * one_beta + bottom * beta;
-        }
-        texel
+        lerp_channels::<L>(&top, &bottom, one_beta, beta)
     }
 
     /// Each lane's level offset, width and height from the level table: one splat when every
@@ -263,6 +276,23 @@ fn unpack_lanes<L: Lanes>(srgb: Option<&[u32; 256]>, texel: L::I32) -> Channels<
     }
 }
 
+/// `a·keep + b·weight` per channel (one bilinear step: `keep = 1 − weight`). A plain loop, not
+/// a closure: a closure would be compiled without the instruction set's target feature and call
+/// the lane operations out of line.
+#[inline(always)]
+fn lerp_channels<L: Lanes>(
+    a: &Channels<L>,
+    b: &Channels<L>,
+    keep: L::F32,
+    weight: L::F32,
+) -> Channels<L> {
+    let mut out = *a;
+    for c in 0..4 {
+        out[c] = a[c] * keep + b[c] * weight;
+    }
+    out
+}
+
 /// The levels and filter each lane reads.
 struct LevelSelection<L: Lanes> {
     /// The level read by every lane.
@@ -276,6 +306,23 @@ struct LevelSelection<L: Lanes> {
 }
 
 impl<L: Lanes> LevelSelection<L> {
+    /// [`LevelSelection::new`] when every lane is magnified (λ ≤ 0): level 0 with the
+    /// magnification filter, nothing blended (the same values `new` gives such lanes).
+    #[inline(always)]
+    fn magnified(lanes: L, sampler: &Sampler) -> Self {
+        let level_zero = lanes.splat_i32(0);
+        let second = match sampler.min_filter {
+            MinFilter::NearestMipmapLinear | MinFilter::LinearMipmapLinear => lanes.splat_i32(1),
+            _ => level_zero,
+        };
+        Self {
+            first: level_zero,
+            second,
+            fraction: lanes.splat_f32(0.0),
+            nearest: lanes.mask_all(sampler.mag_filter == Filter::Nearest),
+        }
+    }
+
     /// OpenGL's level selection ([`Texture::sample_lod`]) per lane: λ ≤ 0 magnifies from level 0
     /// with the magnification filter; otherwise the minification filter picks the level(s).
     #[inline(always)]
@@ -385,6 +432,11 @@ fn footprint2<L: Lanes>(d: [L::F32; 2], width: L::F32, height: L::F32) -> L::F32
 /// `log2 x` for positive normal `x`, from the exponent bits and a polynomial in
 /// `s = (m − 1)/(m + 1)` with the mantissa `m` in `[√½, √2)`: `log2 m = (2/ln 2)·atanh s`, the
 /// series to `s⁹` (truncation below 2e-9 for `|s| ≤ 0.172`). Other inputs give unspecified values.
+///
+/// The result is at most 0 exactly when `x ≤ 1`: it is 0 at 1; below 1 the exponent is negative,
+/// or 0 with `m < 1` and so `s < 0`; above 1 the exponent is positive, or 0 with `m > 1`; and
+/// `|s · poly| < ½`. The sampler relies on it to skip the level of detail of magnified lanes
+/// (tested over the floats around 1 and around every power of two).
 #[inline(always)]
 pub(super) fn log2_normal<L: Lanes>(x: L::F32) -> L::F32 {
     let lanes = x.lanes();
@@ -584,6 +636,30 @@ mod tests {
         }
         for (x, expected) in [(1.0f32, 0.0f32), (2.0, 1.0), (0.5, -1.0), (1024.0, 10.0)] {
             assert_eq!(dispatch(Isa::Scalar, Log2([x; 8]))[0], expected);
+        }
+    }
+
+    /// The polynomial `log2` is at most 0 exactly when its argument is at most 1 (the sampler
+    /// skips the level of detail of magnified lanes on it): over the 2^21 floats on each side of
+    /// 1 and the 2^13 on each side of every power of two.
+    #[test]
+    fn log2_polynomial_is_positive_exactly_above_one() {
+        let check = |centre: f32, reach: u32| {
+            let first =
+                centre.to_bits() - reach.min(centre.to_bits() - f32::MIN_POSITIVE.to_bits());
+            let last = centre.to_bits() + reach;
+            let bits: Vec<u32> = (first..last).collect();
+            for chunk in bits.chunks_exact(8) {
+                let x: [f32; 8] = std::array::from_fn(|k| f32::from_bits(chunk[k]));
+                let log2 = dispatch(Isa::Scalar, Log2(x));
+                for k in 0..8 {
+                    assert_eq!(log2[k] <= 0.0, x[k] <= 1.0, "log2 {} = {}", x[k], log2[k]);
+                }
+            }
+        };
+        check(1.0, 1 << 21);
+        for exponent in -125..=127 {
+            check(2f32.powi(exponent), 1 << 13);
         }
     }
 
