@@ -17,7 +17,7 @@ use super::shader::{vertex_varyings, FragmentLanes, Interpolation, Shader};
 use crate::fixed::pixel_center;
 use crate::raster::bin::{TileBins, TriangleRef};
 use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
-use crate::rop::{BlendMode, BlockRows, DeferredClear, Framebuffer, TileBuffer};
+use crate::rop::{BlendMode, BlockRows, DeferredClear, DepthFunc, Framebuffer, TileBuffer};
 use crate::setup::TriangleSetup;
 use crate::simd::{dispatch, prefetch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
 
@@ -311,6 +311,9 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
         // Replace ignores the stored colour and passes the sanitised source through: nothing
         // to load, and nothing new to sanitise after blending.
         let blend_reads_target = state.blend != BlendMode::Replace;
+        // LESS, every built-in material's test, is compared directly: the general function is a
+        // jump table in the row loop.
+        let depth_less = state.depth_func == DepthFunc::Less;
 
         for block in coverage.blocks() {
             // Depth hierarchy, second level: a block whose every stored depth is in front of the
@@ -352,7 +355,12 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                             Some(clear) => clear.depth,
                             None => lanes.load_f32(&rows.depth[at..at + 8]),
                         };
-                        active = active.and(state.depth_func.passes_lanes(lanes, depth, stored));
+                        let passes = if depth_less {
+                            depth.simd_lt(stored)
+                        } else {
+                            state.depth_func.passes_lanes(lanes, depth, stored)
+                        };
+                        active = active.and(passes);
                     }
                     let active_bits = active.bits();
                     if active_bits == 0 {
