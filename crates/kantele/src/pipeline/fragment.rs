@@ -411,17 +411,28 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                     Some((blended, depth, keep))
                 };
                 let [r, g, b, a] = &mut rows.color;
-                match (written, &pending) {
-                    (Some((color, depth, keep)), None) => {
-                        color[0].store_masked(keep, &mut r[at..at + 8]);
-                        color[1].store_masked(keep, &mut g[at..at + 8]);
-                        color[2].store_masked(keep, &mut b[at..at + 8]);
-                        color[3].store_masked(keep, &mut a[at..at + 8]);
-                        if state.depth_write {
-                            depth.store_masked(keep, &mut rows.depth[at..at + 8]);
+                match &pending {
+                    None => {
+                        if let Some((color, depth, keep)) = written {
+                            color[0].store_masked(keep, &mut r[at..at + 8]);
+                            color[1].store_masked(keep, &mut g[at..at + 8]);
+                            color[2].store_masked(keep, &mut b[at..at + 8]);
+                            color[3].store_masked(keep, &mut a[at..at + 8]);
+                            if state.depth_write {
+                                depth.store_masked(keep, &mut rows.depth[at..at + 8]);
+                            }
                         }
                     }
-                    (Some((color, depth, keep)), Some(clear)) => {
+                    // The whole row: the triangle's values where kept, the clear elsewhere (a
+                    // row the triangle did not write keeps no lane).
+                    Some(clear) => {
+                        let (color, depth, keep) =
+                            written.unwrap_or((clear.color, clear.depth, lanes.mask_all(false)));
+                        let depth = if state.depth_write {
+                            depth
+                        } else {
+                            clear.depth
+                        };
                         keep.select_f32(color[0], clear.color[0])
                             .store(&mut r[at..at + 8]);
                         keep.select_f32(color[1], clear.color[1])
@@ -430,21 +441,9 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                             .store(&mut b[at..at + 8]);
                         keep.select_f32(color[3], clear.color[3])
                             .store(&mut a[at..at + 8]);
-                        let depth = if state.depth_write {
-                            keep.select_f32(depth, clear.depth)
-                        } else {
-                            clear.depth
-                        };
-                        depth.store(&mut rows.depth[at..at + 8]);
+                        keep.select_f32(depth, clear.depth)
+                            .store(&mut rows.depth[at..at + 8]);
                     }
-                    (None, Some(clear)) => {
-                        clear.color[0].store(&mut r[at..at + 8]);
-                        clear.color[1].store(&mut g[at..at + 8]);
-                        clear.color[2].store(&mut b[at..at + 8]);
-                        clear.color[3].store(&mut a[at..at + 8]);
-                        clear.depth.store(&mut rows.depth[at..at + 8]);
-                    }
-                    (None, None) => {}
                 }
             }
             let shaded_count = shaded_bits.count_ones() as u64;

@@ -316,12 +316,11 @@ impl TileBuffer {
     pub fn take_pending_block(&mut self, block: usize) -> Option<DeferredClear> {
         debug_assert_eq!(self.samples, 1);
         let clear = self.deferred_clear.as_mut()?;
-        let bit = 1u64 << block;
-        if clear.pending & bit == 0 {
+        if !clear.pending_block(block) {
             return None;
         }
         let taken = *clear;
-        clear.pending &= !bit;
+        clear.pending &= !(1u64 << block);
         if clear.pending == 0 {
             self.deferred_clear = None;
         }
@@ -462,7 +461,7 @@ impl TileBuffer {
                     bound = bound.max(self.block_depth_max[block_index]);
                     continue;
                 }
-                if let Some(clear) = pending.filter(|c| c.pending & (1 << block_index) != 0) {
+                if let Some(clear) = pending.filter(|c| c.pending_block(block_index)) {
                     bound = bound.max(clear.depth);
                     continue;
                 }
@@ -490,19 +489,18 @@ impl TileBuffer {
 }
 
 impl DeferredClear {
+    /// Whether block `block` is pending.
+    #[inline(always)]
+    fn pending_block(&self, block: usize) -> bool {
+        self.pending & (1u64 << block) != 0
+    }
+
     /// Whether the pixel at tile index `index` lies in a pending block.
     #[inline(always)]
     fn holds(&self, index: usize) -> bool {
-        self.pending & (1u64 << block_of_index(index)) != 0
+        let (x, y) = (index % TILE_SIZE as usize, index / TILE_SIZE as usize);
+        self.pending_block(TileBuffer::block_index(x as i32, y as i32))
     }
-}
-
-/// The block (row-major blocks of the tile) holding tile index `index`.
-#[inline(always)]
-fn block_of_index(index: usize) -> usize {
-    let blocks_log2 = (TILE_LOG2 - BLOCK_LOG2) as usize;
-    let (x, y) = (index & (TILE_SIZE as usize - 1), index >> TILE_LOG2);
-    ((y >> BLOCK_LOG2) << blocks_log2) | (x >> BLOCK_LOG2)
 }
 
 /// Sets the 8 × 8 block of `plane` (one tile plane) whose first pixel is `first` to `value`.
@@ -513,12 +511,15 @@ fn fill_block(plane: &mut [f32], first: usize, value: f32) {
     }
 }
 
-/// Tile index of the first pixel of block `block`.
+/// Tile index of the first pixel of block `block` (the inverse of [`TileBuffer::block_index`]).
 #[inline(always)]
 fn block_first_pixel(block: usize) -> usize {
-    let blocks_log2 = (TILE_LOG2 - BLOCK_LOG2) as usize;
-    let (bx, by) = (block & ((1 << blocks_log2) - 1), block >> blocks_log2);
-    ((by << BLOCK_LOG2) << TILE_LOG2) | (bx << BLOCK_LOG2)
+    let blocks_per_row = (TILE_SIZE / BLOCK_SIZE) as usize;
+    let (bx, by) = (block % blocks_per_row, block / blocks_per_row);
+    TileBuffer::index(
+        (bx * BLOCK_SIZE as usize) as i32,
+        (by * BLOCK_SIZE as usize) as i32,
+    )
 }
 
 /// A vector of `n` copies of `value`, or an error instead of an abort when memory runs out.

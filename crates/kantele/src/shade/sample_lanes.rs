@@ -81,9 +81,7 @@ impl Texture {
                 self.sample_level_lanes::<L>(sampler, srgb, selection.second, uv, nearest, live);
             // A lane with fraction 0 keeps `first` exactly: a·1 + b·0 = a for finite b ≥ 0.
             let keep = lanes.splat_f32(1.0) - selection.fraction;
-            for c in 0..4 {
-                texel[c] = first[c] * keep + second[c] * selection.fraction;
-            }
+            texel = lerp_channels::<L>(&first, &second, keep, selection.fraction);
         }
         // Raw bytes to [0, 1]: alpha always, red, green and blue in a linear texture.
         let scale = lanes.splat_f32(255.0);
