@@ -56,8 +56,41 @@ impl StandardVertex {
     }
 }
 
-/// Varyings: world normal (3), texcoord (2), colour (4).
-const VARYINGS: usize = 9;
+/// Which varyings a draw writes and interpolates: the world normal (varyings 0–2), the texture
+/// coordinate (3–4) and the vertex colour (5–8), each only when the draw's fragment program
+/// reads it. The places are fixed, so the fragment program's indices are constants; the count
+/// ends after the last one read (places before it that are not read hold 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct VaryingLayout {
+    /// Lambert shading or the normals pass.
+    normal: bool,
+    /// A base colour or emissive texture.
+    texcoord: bool,
+    /// A mesh with vertex colours.
+    color: bool,
+}
+
+impl VaryingLayout {
+    /// First of the normal's three varyings.
+    const NORMAL: usize = 0;
+    /// First of the texture coordinate's two.
+    const TEXCOORD: usize = 3;
+    /// First of the colour's four.
+    const COLOR: usize = 5;
+
+    /// Varyings written: up to the end of the last one read.
+    fn count(self) -> usize {
+        if self.color {
+            Self::COLOR + 4
+        } else if self.texcoord {
+            Self::TEXCOORD + 2
+        } else if self.normal {
+            Self::NORMAL + 3
+        } else {
+            0
+        }
+    }
+}
 
 /// Light and camera shared by every draw of a frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -82,6 +115,10 @@ pub struct MaterialShader<'a> {
     ids: (f32, f32),
     /// Emissive texture (see [`MaterialShader::with_emissive_texture`]).
     emissive_texture: Option<(&'a Texture, Sampler)>,
+    /// Whether the mesh has vertex colours (see [`MaterialShader::with_vertex_colors`]).
+    vertex_colors: bool,
+    /// Which varyings the fragment program reads, decided once per draw.
+    layout: VaryingLayout,
     /// The material's properties for the lane program of an untextured colour-pass draw,
     /// decided once per draw (`None` for every other draw).
     untextured_color: Option<UntexturedColor>,
@@ -93,6 +130,7 @@ pub struct MaterialShader<'a> {
 #[derive(Clone, Copy, Debug)]
 struct UntexturedColor {
     unlit: bool,
+    vertex_colors: bool,
     alpha_mode: AlphaMode,
     base_color_factor: [f32; 4],
     emissive: Vec3,
@@ -120,18 +158,32 @@ impl<'a> MaterialShader<'a> {
             pass,
             ids: (ids.0 as f32, ids.1 as f32),
             emissive_texture: None,
+            vertex_colors: true,
+            layout: VaryingLayout {
+                normal: true,
+                texcoord: true,
+                color: true,
+            },
             untextured_color: None,
         }
         .with_lane_program()
     }
 
-    /// Decides which lane program the draw runs (see [`UntexturedColor`]).
+    /// Decides which varyings the draw interpolates ([`VaryingLayout`]) and which lane program
+    /// it runs (see [`UntexturedColor`]).
     fn with_lane_program(mut self) -> Self {
         let m = self.material;
+        let lit = self.pass == Pass::Color && !m.unlit;
+        self.layout = VaryingLayout {
+            normal: lit || self.pass == Pass::Normals,
+            texcoord: self.texture.is_some() || self.emissive_texture.is_some(),
+            color: self.vertex_colors,
+        };
         let untextured_color =
             self.pass == Pass::Color && self.texture.is_none() && self.emissive_texture.is_none();
         self.untextured_color = untextured_color.then_some(UntexturedColor {
             unlit: m.unlit,
+            vertex_colors: self.layout.color,
             alpha_mode: m.alpha_mode,
             base_color_factor: m.base_color_factor.to_array(),
             emissive: m.emissive,
@@ -144,6 +196,14 @@ impl<'a> MaterialShader<'a> {
     /// × this texture at the base colour's texture coordinates, added after lighting).
     pub fn with_emissive_texture(mut self, texture: Option<(&'a Texture, Sampler)>) -> Self {
         self.emissive_texture = texture;
+        self.with_lane_program()
+    }
+
+    /// Whether the mesh has vertex colours (glTF `COLOR_0`; the default is yes). Without them
+    /// the colour is white, the base colour is `baseColorFactor` × the texture exactly, and no
+    /// colour is interpolated.
+    pub fn with_vertex_colors(mut self, present: bool) -> Self {
+        self.vertex_colors = present;
         self.with_lane_program()
     }
 
@@ -170,18 +230,27 @@ impl<'a> MaterialShader<'a> {
     #[inline]
     fn base_color(&self, fragment: &Fragment<'_>) -> Vec4 {
         let v = fragment.varyings();
-        let color = Vec4::new(v[5], v[6], v[7], v[8]);
+        let color = if self.layout.color {
+            let c = VaryingLayout::COLOR;
+            Vec4::new(v[c], v[c + 1], v[c + 2], v[c + 3])
+        } else {
+            Vec4::ONE
+        };
         let mut base = self.material.base_color_factor * color;
         if let Some((texture, sampler)) = self.texture {
-            base *= sample(fragment, texture, &sampler);
+            base *= sample(fragment, self.layout, texture, &sampler);
         }
         base
     }
 
     #[inline]
     fn normal(&self, fragment: &Fragment<'_>) -> Vec3 {
+        if !self.layout.normal {
+            return Vec3::ZERO;
+        }
+        let at = VaryingLayout::NORMAL;
         let v = fragment.varyings();
-        let n = Vec3::new(v[0], v[1], v[2]).normalize_or_zero();
+        let n = Vec3::new(v[at], v[at + 1], v[at + 2]).normalize_or_zero();
         if self.material.double_sided && !fragment.front_facing {
             -n
         } else {
@@ -194,15 +263,27 @@ impl Shader for MaterialShader<'_> {
     type Vertex = StandardVertex;
 
     fn varying_count(&self) -> usize {
-        VARYINGS
+        self.layout.count()
     }
 
     #[inline]
     fn vertex(&self, vertex: &StandardVertex, varyings: &mut [f32]) -> Vec4 {
-        let n = self.normal_matrix * vertex.normal;
-        varyings[..3].copy_from_slice(&n.to_array());
-        varyings[3..5].copy_from_slice(&vertex.texcoord.to_array());
-        varyings[5..9].copy_from_slice(&vertex.color.to_array());
+        let layout = self.layout;
+        let count = layout.count();
+        varyings[..count].fill(0.0);
+        if layout.normal {
+            let at = VaryingLayout::NORMAL;
+            let n = self.normal_matrix * vertex.normal;
+            varyings[at..at + 3].copy_from_slice(&n.to_array());
+        }
+        if layout.texcoord {
+            let at = VaryingLayout::TEXCOORD;
+            varyings[at..at + 2].copy_from_slice(&vertex.texcoord.to_array());
+        }
+        if layout.color {
+            let at = VaryingLayout::COLOR;
+            varyings[at..at + 4].copy_from_slice(&vertex.color.to_array());
+        }
         self.model_view_projection * vertex.position.extend(1.0)
     }
 
@@ -249,7 +330,7 @@ impl MaterialShader<'_> {
     fn emissive(&self, fragment: &Fragment<'_>) -> Vec3 {
         let mut emissive = self.material.emissive;
         if let Some((texture, sampler)) = self.emissive_texture {
-            emissive *= sample(fragment, texture, &sampler).truncate();
+            emissive *= sample(fragment, self.layout, texture, &sampler).truncate();
         }
         emissive
     }
@@ -325,12 +406,22 @@ impl MaterialShader<'_> {
     ) -> ShadedLanes<L> {
         let lanes = f.lanes;
         let factor = program.base_color_factor;
-        let base = [
-            lanes.splat_f32(factor[0]) * f.varying(5),
-            lanes.splat_f32(factor[1]) * f.varying(6),
-            lanes.splat_f32(factor[2]) * f.varying(7),
-            lanes.splat_f32(factor[3]) * f.varying(8),
-        ];
+        let c = VaryingLayout::COLOR;
+        let base = if program.vertex_colors {
+            [
+                lanes.splat_f32(factor[0]) * f.varying(c),
+                lanes.splat_f32(factor[1]) * f.varying(c + 1),
+                lanes.splat_f32(factor[2]) * f.varying(c + 2),
+                lanes.splat_f32(factor[3]) * f.varying(c + 3),
+            ]
+        } else {
+            [
+                lanes.splat_f32(factor[0]),
+                lanes.splat_f32(factor[1]),
+                lanes.splat_f32(factor[2]),
+                lanes.splat_f32(factor[3]),
+            ]
+        };
         let (alpha, keep) = Self::alpha_lanes(lanes, program.alpha_mode, base[3]);
         let e = program.emissive;
         let emissive = [
@@ -410,7 +501,7 @@ impl MaterialShader<'_> {
             lanes.splat_f32(e.z),
         ];
         if let Some((texture, sampler)) = self.emissive_texture {
-            let texel = sample_lanes(f, texture, &sampler);
+            let texel = sample_lanes(f, self.layout, texture, &sampler);
             for c in 0..3 {
                 emissive[c] = emissive[c] * texel[c];
             }
@@ -418,19 +509,41 @@ impl MaterialShader<'_> {
         emissive
     }
 
+    /// `factor × COLOR_0` per lane: `factor` itself without vertex colours (as `factor × 1` in
+    /// [`MaterialShader::base_color`], exactly).
+    #[inline(always)]
+    fn factor_times_color_lanes<L: Lanes>(
+        &self,
+        f: &FragmentLanes<'_, L>,
+        factor: [f32; 4],
+    ) -> [L::F32; 4] {
+        let lanes = f.lanes;
+        // No closure (`map`): see [`crate::simd`].
+        let factor = [
+            lanes.splat_f32(factor[0]),
+            lanes.splat_f32(factor[1]),
+            lanes.splat_f32(factor[2]),
+            lanes.splat_f32(factor[3]),
+        ];
+        if self.layout.color {
+            let c = VaryingLayout::COLOR;
+            [
+                factor[0] * f.varying(c),
+                factor[1] * f.varying(c + 1),
+                factor[2] * f.varying(c + 2),
+                factor[3] * f.varying(c + 3),
+            ]
+        } else {
+            factor
+        }
+    }
+
     /// `baseColorFactor × COLOR_0 × texture(uv)` per lane; the texture is sampled lane-wide.
     #[inline(always)]
     fn base_color_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> [L::F32; 4] {
-        let lanes = f.lanes;
-        let factor = self.material.base_color_factor.to_array();
-        let mut base = [
-            lanes.splat_f32(factor[0]) * f.varying(5),
-            lanes.splat_f32(factor[1]) * f.varying(6),
-            lanes.splat_f32(factor[2]) * f.varying(7),
-            lanes.splat_f32(factor[3]) * f.varying(8),
-        ];
+        let mut base = self.factor_times_color_lanes(f, self.material.base_color_factor.to_array());
         if let Some((texture, sampler)) = self.texture {
-            let texel = sample_lanes(f, texture, &sampler);
+            let texel = sample_lanes(f, self.layout, texture, &sampler);
             for c in 0..4 {
                 base[c] = base[c] * texel[c];
             }
@@ -443,7 +556,11 @@ impl MaterialShader<'_> {
     #[inline(always)]
     fn normal_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>, double_sided: bool) -> [L::F32; 3] {
         let lanes = f.lanes;
-        let n = [f.varying(0), f.varying(1), f.varying(2)];
+        if !self.layout.normal {
+            return [lanes.splat_f32(0.0); 3];
+        }
+        let at = VaryingLayout::NORMAL;
+        let n = [f.varying(at), f.varying(at + 1), f.varying(at + 2)];
         let length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
         let rcp = lanes.splat_f32(1.0) / length2.sqrt();
         let usable = rcp
@@ -482,19 +599,24 @@ impl MaterialShader<'_> {
     }
 }
 
-/// A texture sampled at the material's texture coordinates (varyings 3 and 4) with their
-/// analytic screen-space derivatives, lane-wide.
+/// A texture sampled at the material's texture coordinates ([`VaryingLayout::TEXCOORD`]; 0
+/// where `layout` has none) with their analytic screen-space derivatives, lane-wide.
 #[inline(always)]
 fn sample_lanes<L: Lanes>(
     f: &FragmentLanes<'_, L>,
+    layout: VaryingLayout,
     texture: &Texture,
     sampler: &Sampler,
 ) -> [L::F32; 4] {
-    let (du_dx, du_dy) = f.derivatives(3);
-    let (dv_dx, dv_dy) = f.derivatives(4);
+    if !layout.texcoord {
+        return [f.lanes.splat_f32(0.0); 4];
+    }
+    let u = VaryingLayout::TEXCOORD;
+    let (du_dx, du_dy) = f.derivatives(u);
+    let (dv_dx, dv_dy) = f.derivatives(u + 1);
     texture.sample_grad_lanes::<L>(
         sampler,
-        [f.varying(3), f.varying(4)],
+        [f.varying(u), f.varying(u + 1)],
         [du_dx, dv_dx],
         [du_dy, dv_dy],
         f.active,
@@ -503,13 +625,22 @@ fn sample_lanes<L: Lanes>(
 
 /// [`sample_lanes`] for one fragment.
 #[inline]
-fn sample(fragment: &Fragment<'_>, texture: &Texture, sampler: &Sampler) -> Vec4 {
+fn sample(
+    fragment: &Fragment<'_>,
+    layout: VaryingLayout,
+    texture: &Texture,
+    sampler: &Sampler,
+) -> Vec4 {
+    if !layout.texcoord {
+        return Vec4::ZERO;
+    }
+    let u = VaryingLayout::TEXCOORD;
     let v = fragment.varyings();
-    let (du_dx, du_dy) = fragment.derivatives(3);
-    let (dv_dx, dv_dy) = fragment.derivatives(4);
+    let (du_dx, du_dy) = fragment.derivatives(u);
+    let (dv_dx, dv_dy) = fragment.derivatives(u + 1);
     texture.sample_grad(
         sampler,
-        Vec2::new(v[3], v[4]),
+        Vec2::new(v[u], v[u + 1]),
         Vec2::new(du_dx, dv_dx),
         Vec2::new(du_dy, dv_dy),
     )

@@ -169,6 +169,7 @@ impl Backend for CpuBackend {
                         .emissive_texture
                         .map(|b| (&*scene.textures[b.texture], b.sampler)),
                 )
+                .with_vertex_colors(scene.meshes[draw.mesh].colors.is_some())
             })
             .collect();
         let clear = match view.pass {
@@ -219,7 +220,7 @@ mod tests {
     use super::*;
     use crate::backend::FrameView;
     use crate::scene::{Draw, Material};
-    use glam::{Mat4, Vec3};
+    use glam::{Mat4, Vec3, Vec4};
 
     /// A single-sided quad facing the camera, drawn once plainly and once through a mirroring
     /// model matrix: both must be visible (the mirror flips which winding is front).
@@ -262,5 +263,56 @@ mod tests {
             mirrored, plain,
             "the mirrored quad must be drawn, not culled"
         );
+    }
+    /// Without vertex colours the base colour is the factor exactly (no interpolated white,
+    /// whose weights need not sum to exactly 1); with white vertex colours it is within rounding.
+    #[test]
+    fn meshes_without_vertex_colors_shade_with_the_factor_exactly() {
+        let factor = Vec4::new(0.3, 0.6, 0.9, 1.0);
+        let image = |colors: Option<Vec<Vec4>>| {
+            let quad = Mesh {
+                positions: vec![
+                    Vec3::new(-0.5, -0.4, 0.0),
+                    Vec3::new(0.6, -0.5, -0.3),
+                    Vec3::new(0.5, 0.5, 0.2),
+                    Vec3::new(-0.5, 0.45, 0.1),
+                ],
+                colors,
+                indices: vec![0, 1, 2, 0, 2, 3],
+                ..Mesh::default()
+            };
+            let scene = Scene {
+                meshes: vec![quad],
+                materials: vec![Material {
+                    base_color_factor: factor,
+                    unlit: true,
+                    ..Material::default()
+                }],
+                draws: vec![Draw {
+                    mesh: 0,
+                    model: Mat4::IDENTITY,
+                    node_name: String::new(),
+                    node_index: 0,
+                }],
+                camera: crate::scene::Camera::framing(Vec3::ZERO, 1.0, Vec3::Z, 1.0),
+                resolution: (64, 64),
+                clear_color: Vec4::ZERO,
+                ..Scene::default()
+            };
+            let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu");
+            cpu.load(Arc::new(scene.clone())).expect("load");
+            cpu.render(&FrameView::of_scene(&scene)).expect("render");
+            cpu.read_frame().expect("read")
+        };
+        let plain = image(None);
+        let covered: Vec<_> = plain.color.iter().filter(|c| c[3] > 0.0).collect();
+        assert!(covered.len() > 500, "{} pixels", covered.len());
+        assert!(covered.iter().all(|c| **c == factor.to_array()));
+        let white = image(Some(vec![Vec4::ONE; 4]));
+        for (a, b) in plain.color.iter().zip(&white.color) {
+            for (x, y) in a.iter().zip(b) {
+                assert!((x - y).abs() <= 1e-6, "{a:?} vs {b:?}");
+            }
+        }
     }
 }

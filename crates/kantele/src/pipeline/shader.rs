@@ -146,12 +146,7 @@ impl Fragment<'_> {
     /// analytically from the triangle's plane equations (thesis §2.3.3).
     pub fn derivatives(&self, index: usize) -> (f32, f32) {
         let ip = self.interpolation;
-        let n = ip.varying_count;
-        let a = [
-            ip.attrs[index],
-            ip.attrs[n + index],
-            ip.attrs[2 * n + index],
-        ];
+        let a = ip.attrs[index];
         let value = self.varyings[index];
         // v = N / S with S = Σ λ_i / w_i and N = Σ λ_i a_i / w_i; dv = (dN − v dS) / S = (dN − v dS)·w.
         let d = |dl: &[f32; 3]| {
@@ -168,24 +163,28 @@ impl Fragment<'_> {
     }
 }
 
-/// The varyings of a triangle's three (oriented) vertices, vertex-major, in an array of fixed
-/// size (entries past `3 × varying_count` are 0): a shader's constant indices into it need no
-/// bounds check in the per-pixel loop.
-pub(crate) type VertexVaryings = [f32; 3 * MAX_VARYINGS];
+/// The varyings of a triangle's three (oriented) vertices, varying-major (entry `i` holds
+/// varying `i` of vertices 0, 1 and 2), in an array of fixed size (entries past the varying
+/// count are 0): a shader's constant index into it needs no bounds check and no arithmetic in
+/// the per-pixel loop, whatever the draw's varying count.
+pub(crate) type VertexVaryings = [[f32; 3]; MAX_VARYINGS];
 
-/// `attrs` (at most `3 × MAX_VARYINGS` values) as [`VertexVaryings`].
+/// `attrs` (the three vertices' varyings, vertex-major, `3 × varying_count` values with
+/// `varying_count` at most `MAX_VARYINGS`) as [`VertexVaryings`].
 #[inline(always)]
 pub(crate) fn vertex_varyings(attrs: &[f32]) -> VertexVaryings {
-    let mut out = [0.0; 3 * MAX_VARYINGS];
-    let n = attrs.len().min(out.len());
-    out[..n].copy_from_slice(&attrs[..n]);
+    let mut out = [[0.0; 3]; MAX_VARYINGS];
+    let n = (attrs.len() / 3).min(MAX_VARYINGS);
+    for (i, values) in out[..n].iter_mut().enumerate() {
+        *values = [attrs[i], attrs[n + i], attrs[2 * n + i]];
+    }
     out
 }
 
 /// Per-triangle data for interpolation and derivatives, shared by [`Fragment`] and
 /// [`FragmentLanes`] so that both evaluate the same formulas.
 pub(crate) struct Interpolation<'a> {
-    /// Varyings of the three (oriented) vertices, vertex-major.
+    /// Varyings of the three (oriented) vertices, varying-major.
     pub(crate) attrs: &'a VertexVaryings,
     pub(crate) varying_count: usize,
     pub(crate) inv_w: [f32; 3],
@@ -226,12 +225,11 @@ impl<'a, L: Lanes> FragmentLanes<'a, L> {
     /// Interpolated varying `index` (perspective-correct): `Σ weight_i · a_i`.
     #[inline(always)]
     pub fn varying(&self, index: usize) -> L::F32 {
-        let ip = self.interpolation;
-        let n = ip.varying_count;
+        let a = self.interpolation.attrs[index];
         let lanes = self.lanes;
-        self.weights[0] * lanes.splat_f32(ip.attrs[index])
-            + self.weights[1] * lanes.splat_f32(ip.attrs[n + index])
-            + self.weights[2] * lanes.splat_f32(ip.attrs[2 * n + index])
+        self.weights[0] * lanes.splat_f32(a[0])
+            + self.weights[1] * lanes.splat_f32(a[1])
+            + self.weights[2] * lanes.splat_f32(a[2])
     }
 
     /// Perspective-correct barycentric weights of the triangle's vertices (sum to 1).
@@ -245,14 +243,9 @@ impl<'a, L: Lanes> FragmentLanes<'a, L> {
     #[inline(always)]
     pub fn derivatives(&self, index: usize) -> (L::F32, L::F32) {
         let ip = self.interpolation;
-        let n = ip.varying_count;
         let lanes = self.lanes;
         let value = self.varying(index);
-        let a = [
-            ip.attrs[index],
-            ip.attrs[n + index],
-            ip.attrs[2 * n + index],
-        ];
+        let a = ip.attrs[index];
         let d = |dl: &[f32; 3]| {
             let dq = [
                 dl[0] * ip.inv_w[0],
@@ -296,10 +289,8 @@ impl<'a, L: Lanes> FragmentLanes<'a, L> {
             per_lane.weights[1][k],
             per_lane.weights[2][k],
         ];
-        for (i, v) in varyings[..n].iter_mut().enumerate() {
-            *v = weights[0] * ip.attrs[i]
-                + weights[1] * ip.attrs[n + i]
-                + weights[2] * ip.attrs[2 * n + i];
+        for (v, a) in varyings[..n].iter_mut().zip(ip.attrs) {
+            *v = weights[0] * a[0] + weights[1] * a[1] + weights[2] * a[2];
         }
         Fragment {
             x: self.x + k as u32,
