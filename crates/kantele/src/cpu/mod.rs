@@ -119,6 +119,10 @@ impl Backend for CpuBackend {
     fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError> {
         scene.validate()?;
         let meshes = scene.meshes.iter().map(PreparedMesh::new).collect();
+        // Decoded texels for the lane-wide sampler, now rather than in the first frame.
+        for texture in &scene.textures {
+            texture.prepare_lane_sampling();
+        }
         self.scene = Some((scene, meshes));
         Ok(())
     }

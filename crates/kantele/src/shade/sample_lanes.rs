@@ -6,23 +6,40 @@
 //! lane, every wrap mode and every filter. Texels are fetched with [`I32x8::gather_u32`] (each
 //! lane's level offset and size gathered from the level table), or, where the two columns of
 //! every lane's bilinear footprint are neighbours in memory, one row's two texels at once with
-//! [`TexelGather::gather_u32_pair`]; sRGB bytes are decoded lane-wide through the 256-entry
-//! table ([`TexelGather::lookup_rgb`]).
+//! [`TexelGather::gather_u32_pair`]. sRGB textures are filtered in 16-bit linear units
+//! ([`srgb_to_linear16`](super::texel::srgb_to_linear16)): read from the texture's decoded copy
+//! (two words per texel, one 8-byte read) when it has one, otherwise decoded lane-wide from the
+//! bytes through the 256-entry table of the same values ([`TexelGather::lookup_rgb`]) — the two
+//! give the same bits.
 //! Every step is the same `f32` / `i32` operation in the same order on every instruction set (no
 //! fused multiply-add), so the scalar build and the SIMD builds give identical bits.
 //!
 //! Against the scalar sampler, results may differ in the last bits: `log2` is a polynomial here
-//! (absolute error below 1e-6 for the level of detail), and linear channels (alpha, and all four
-//! in a linear texture) are filtered as bytes and divided by 255 once at the end.
+//! (absolute error below 1e-6 for the level of detail), linear textures are filtered as bytes
+//! and scaled by 1/255 once at the end, and sRGB textures as 16-bit linear values (red, green
+//! and blue within half a unit of 1/65535 of the exact decode) scaled by 1/65535 at the end.
 
 use crate::simd::{F32x8, I32x8, Lanes, Mask8, MaskOf, TexelGather};
 
-use super::texel::decode_table;
+use super::texel::linear16_table;
 use super::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
 
-/// One lane value per texel byte: red, green and blue decoded to linear (sRGB) or raw bytes
-/// (linear), alpha always a raw byte.
+/// One lane value per texel channel, in the units of its [`TexelSource`]: 16-bit linear units for
+/// sRGB textures, raw bytes for linear ones.
 type Channels<L> = [<L as Lanes>::F32; 4];
+
+/// Where the sampler reads a texture's texels, and how it unpacks them to [`Channels`].
+#[derive(Clone, Copy)]
+enum TexelSource<'t> {
+    /// A linear texture's packed bytes, every channel as its raw byte value (0–255).
+    LinearBytes(&'t [u32]),
+    /// An sRGB texture's packed bytes: red, green and blue decoded through the table of 16-bit
+    /// linear values ([`linear16_table`]), alpha as `a · 257`.
+    SrgbBytes(&'t [u32], &'t [u32; 256]),
+    /// An sRGB texture's decoded copy: two words per texel, `[r | g << 16, b | a << 16]`, the same
+    /// values as `SrgbBytes` gives.
+    Linear16(&'t [u32]),
+}
 
 impl Texture {
     /// Samples eight texture coordinates at once, each with the level of detail from its own
@@ -35,6 +52,30 @@ impl Texture {
     #[inline(always)]
     pub fn sample_grad_lanes<L: Lanes>(
         &self,
+        sampler: &Sampler,
+        uv: [L::F32; 2],
+        duv_dx: [L::F32; 2],
+        duv_dy: [L::F32; 2],
+        active: MaskOf<L>,
+    ) -> [L::F32; 4] {
+        self.sample_grad_lanes_from::<L>(self.lane_texels(), sampler, uv, duv_dx, duv_dy, active)
+    }
+
+    /// Where [`Texture::sample_grad_lanes`] reads the texels: the decoded copy of an sRGB
+    /// texture when it has one ([`Texture::linear16`]), otherwise the bytes.
+    fn lane_texels(&self) -> TexelSource<'_> {
+        match (self.color_space, self.linear16()) {
+            (ColorSpace::Linear, _) => TexelSource::LinearBytes(&self.texels),
+            (ColorSpace::Srgb, Some(words)) => TexelSource::Linear16(words),
+            (ColorSpace::Srgb, None) => TexelSource::SrgbBytes(&self.texels, linear16_table()),
+        }
+    }
+
+    /// [`Texture::sample_grad_lanes`] reading `source`.
+    #[inline(always)]
+    fn sample_grad_lanes_from<L: Lanes>(
+        &self,
+        source: TexelSource<'_>,
         sampler: &Sampler,
         uv: [L::F32; 2],
         duv_dx: [L::F32; 2],
@@ -58,11 +99,6 @@ impl Texture {
         if live.none() {
             return [zero; 4];
         }
-        // The sRGB table, looked up once per call rather than once per texel (a `OnceLock`).
-        let srgb = match self.color_space {
-            ColorSpace::Srgb => Some(decode_table(ColorSpace::Srgb)),
-            ColorSpace::Linear => None,
-        };
         let rho2 = self.footprint_lanes::<L>(duv_dx, duv_dy);
         // λ ≤ 0 exactly where ρ² ≤ 1 (see `log2_normal`), so when every live lane is magnified
         // the level of detail is not needed: level 0, no blend.
@@ -72,25 +108,26 @@ impl Texture {
             LevelSelection::<L>::new(self, sampler, self.lod_lanes::<L>(rho2))
         };
         let nearest = selection.nearest;
-        let first = self.sample_level_lanes::<L>(sampler, srgb, selection.first, uv, nearest, live);
+        let first =
+            self.sample_level_lanes::<L>(sampler, source, selection.first, uv, nearest, live);
         // The second level only where some live lane blends (trilinear between levels).
         let blend = selection.fraction.simd_gt(zero).and(live);
         let mut texel = first;
         if blend.any() {
             let second =
-                self.sample_level_lanes::<L>(sampler, srgb, selection.second, uv, nearest, live);
+                self.sample_level_lanes::<L>(sampler, source, selection.second, uv, nearest, live);
             // A lane with fraction 0 keeps `first` exactly: a·1 + b·0 = a for finite b ≥ 0.
             let keep = lanes.splat_f32(1.0) - selection.fraction;
             texel = lerp_channels::<L>(&first, &second, keep, selection.fraction);
         }
-        // Raw bytes to [0, 1]: alpha always, red, green and blue in a linear texture.
-        let scale = lanes.splat_f32(255.0);
-        let raw_channels = match self.color_space {
-            ColorSpace::Srgb => 3..4,
-            ColorSpace::Linear => 0..4,
-        };
-        for c in raw_channels {
-            texel[c] = texel[c] / scale;
+        // Bytes or 16-bit units to [0, 1], multiplied by the reciprocal (a division per channel
+        // would cost more than the rest of the step; the full-scale value still gives 1 exactly).
+        let scale = lanes.splat_f32(match self.color_space {
+            ColorSpace::Srgb => 1.0 / 65535.0,
+            ColorSpace::Linear => 1.0 / 255.0,
+        });
+        for channel in &mut texel {
+            *channel = *channel * scale;
         }
         for channel in &mut texel {
             *channel = live.select_f32(*channel, zero);
@@ -133,13 +170,13 @@ impl Texture {
     }
 
     /// Filters one level per lane (`level` holds each lane's level index) at `uv`, nearest where
-    /// `nearest` is set and bilinear elsewhere; lanes outside `live` are unspecified. `srgb` is
-    /// the sRGB decode table in an sRGB texture. Returns [`Channels`].
+    /// `nearest` is set and bilinear elsewhere, reading `source`; lanes outside `live` are
+    /// unspecified. Returns [`Channels`].
     #[inline(always)]
     fn sample_level_lanes<L: Lanes>(
         &self,
         sampler: &Sampler,
-        srgb: Option<&[u32; 256]>,
+        source: TexelSource<'_>,
         level: L::I32,
         uv: [L::F32; 2],
         nearest: MaskOf<L>,
@@ -156,7 +193,7 @@ impl Texture {
             let j = sampler
                 .wrap_t
                 .wrap_lanes::<L>(t.coord.to_i32_floor(), height);
-            return self.fetch_lanes::<L>(srgb, offset + j * width + i);
+            return fetch_lanes::<L>(source, offset + j * width + i);
         }
         // Bilinear: texel centres at integer + ½. A nearest lane reads texel ⌊u⌋ with weights
         // (1, 0): t00·1 + t10·0 = t00 exactly, the nearest result.
@@ -179,19 +216,19 @@ impl Texture {
         // the common case), each row's pair of texels is one 8-byte read per lane.
         let neighbours = x1.simd_eq(x0 + one).or(live.not()).all();
         let (top, bottom) = if neighbours {
-            let (t00, t10) = self.fetch_pair_lanes::<L>(srgb, row0 + x0);
+            let (t00, t10) = fetch_pair_lanes::<L>(source, row0 + x0);
             let top = lerp_channels::<L>(&t00, &t10, one_alpha, alpha);
-            let (t01, t11) = self.fetch_pair_lanes::<L>(srgb, row1 + x0);
+            let (t01, t11) = fetch_pair_lanes::<L>(source, row1 + x0);
             (top, lerp_channels::<L>(&t01, &t11, one_alpha, alpha))
         } else {
             let (t00, t10) = (
-                self.fetch_lanes::<L>(srgb, row0 + x0),
-                self.fetch_lanes::<L>(srgb, row0 + x1),
+                fetch_lanes::<L>(source, row0 + x0),
+                fetch_lanes::<L>(source, row0 + x1),
             );
             let top = lerp_channels::<L>(&t00, &t10, one_alpha, alpha);
             let (t01, t11) = (
-                self.fetch_lanes::<L>(srgb, row1 + x0),
-                self.fetch_lanes::<L>(srgb, row1 + x1),
+                fetch_lanes::<L>(source, row1 + x0),
+                fetch_lanes::<L>(source, row1 + x1),
             );
             (top, lerp_channels::<L>(&t01, &t11, one_alpha, alpha))
         };
@@ -223,43 +260,70 @@ impl Texture {
             ),
         }
     }
+}
 
-    /// Gathers the texels at `index` and unpacks them ([`unpack_lanes`]).
-    #[inline(always)]
-    fn fetch_lanes<L: Lanes>(&self, srgb: Option<&[u32; 256]>, index: L::I32) -> Channels<L> {
-        unpack_lanes::<L>(srgb, index.gather_u32(&self.texels))
-    }
-
-    /// The texels at `index` and `index + 1` (one 8-byte read per lane), unpacked
-    /// ([`unpack_lanes`]). `index + 1` must lie in the texture's storage for live lanes.
-    #[inline(always)]
-    fn fetch_pair_lanes<L: Lanes>(
-        &self,
-        srgb: Option<&[u32; 256]>,
-        index: L::I32,
-    ) -> (Channels<L>, Channels<L>) {
-        let (first, second) = index.gather_u32_pair(&self.texels);
-        (
-            unpack_lanes::<L>(srgb, first),
-            unpack_lanes::<L>(srgb, second),
-        )
+/// Gathers the texels at `index` from `source` and unpacks them.
+#[inline(always)]
+fn fetch_lanes<L: Lanes>(source: TexelSource<'_>, index: L::I32) -> Channels<L> {
+    match source {
+        TexelSource::LinearBytes(texels) => unpack_bytes::<L>(None, index.gather_u32(texels)),
+        TexelSource::SrgbBytes(texels, table) => {
+            unpack_bytes::<L>(Some(table), index.gather_u32(texels))
+        }
+        TexelSource::Linear16(words) => {
+            let (rg, ba) = (index + index).gather_u32_pair(words);
+            unpack_words::<L>(rg, ba)
+        }
     }
 }
 
-/// Unpacks packed texels: red, green and blue decoded through `srgb` (the sRGB table) in an sRGB
-/// texture, otherwise (`None`) every channel as its raw byte value (0–255); alpha always raw.
+/// The texels at `index` and `index + 1` from `source` (one 8-byte read per lane and texel of
+/// bytes, one 16-byte read in two halves of a decoded copy), unpacked. `index + 1` must lie in
+/// the texture's storage for live lanes.
 #[inline(always)]
-fn unpack_lanes<L: Lanes>(srgb: Option<&[u32; 256]>, texel: L::I32) -> Channels<L> {
+fn fetch_pair_lanes<L: Lanes>(
+    source: TexelSource<'_>,
+    index: L::I32,
+) -> (Channels<L>, Channels<L>) {
+    match source {
+        TexelSource::LinearBytes(texels) => {
+            let (first, second) = index.gather_u32_pair(texels);
+            (
+                unpack_bytes::<L>(None, first),
+                unpack_bytes::<L>(None, second),
+            )
+        }
+        TexelSource::SrgbBytes(texels, table) => {
+            let (first, second) = index.gather_u32_pair(texels);
+            (
+                unpack_bytes::<L>(Some(table), first),
+                unpack_bytes::<L>(Some(table), second),
+            )
+        }
+        TexelSource::Linear16(words) => {
+            let word = index + index;
+            let (rg0, ba0) = word.gather_u32_pair(words);
+            let (rg1, ba1) = (word + word.lanes().splat_i32(2)).gather_u32_pair(words);
+            (unpack_words::<L>(rg0, ba0), unpack_words::<L>(rg1, ba1))
+        }
+    }
+}
+
+/// Unpacks packed texels: red, green and blue through `table` (16-bit linear values, an sRGB
+/// texture) with alpha as `a · 257`, or (`None`, a linear texture) every channel as its raw byte
+/// value (0–255).
+#[inline(always)]
+fn unpack_bytes<L: Lanes>(table: Option<&[u32; 256]>, texel: L::I32) -> Channels<L> {
     let lanes = texel.lanes();
     let a = texel.shr_logical::<24>().to_f32();
-    match srgb {
+    match table {
         Some(table) => {
             let [r, g, b] = texel.lookup_rgb(table);
             [
                 L::F32::from_bits(r),
                 L::F32::from_bits(g),
                 L::F32::from_bits(b),
-                a,
+                a * lanes.splat_f32(257.0),
             ]
         }
         None => {
@@ -272,6 +336,18 @@ fn unpack_lanes<L: Lanes>(srgb: Option<&[u32; 256]>, texel: L::I32) -> Channels<
             ]
         }
     }
+}
+
+/// Unpacks decoded texels, the words `rg = r | g << 16` and `ba = b | a << 16`, to 16-bit units.
+#[inline(always)]
+fn unpack_words<L: Lanes>(rg: L::I32, ba: L::I32) -> Channels<L> {
+    let low = rg.lanes().splat_i32(0xffff);
+    [
+        (rg & low).to_f32(),
+        rg.shr_logical::<16>().to_f32(),
+        (ba & low).to_f32(),
+        ba.shr_logical::<16>().to_f32(),
+    ]
 }
 
 /// `a·keep + b·weight` per channel (one bilinear step: `keep = 1 − weight`). A plain loop, not
@@ -488,6 +564,8 @@ mod tests {
         texture: &'a Texture,
         sampler: Sampler,
         query: Query,
+        /// Read an sRGB texture's bytes through the table even where it has a decoded copy.
+        bytes: bool,
     }
 
     impl LaneKernel for Sample<'_> {
@@ -501,8 +579,15 @@ mod tests {
                     lanes.f32_from_array(v.map(|p| p.y)),
                 ]
             };
+            let source = match self.texture.lane_texels() {
+                TexelSource::Linear16(_) if self.bytes => {
+                    TexelSource::SrgbBytes(&self.texture.texels, linear16_table())
+                }
+                source => source,
+            };
             self.texture
-                .sample_grad_lanes::<L>(
+                .sample_grad_lanes_from::<L>(
+                    source,
                     &self.sampler,
                     pair(q.uv),
                     pair(q.duv_dx),
@@ -676,6 +761,7 @@ mod tests {
                         texture: &texture,
                         sampler,
                         query,
+                        bytes: false,
                     };
                     let lanes = dispatch(Isa::Scalar, kernel());
                     for &isa in &isas {
@@ -709,6 +795,61 @@ mod tests {
         }
     }
 
+    /// An sRGB texture sampled from its decoded copy and from its bytes through the table gives
+    /// the same bits, on every instruction set, wrap mode and filter.
+    #[test]
+    fn decoded_copy_and_bytes_sample_alike() {
+        let mut rng = Rng(11);
+        let isas = supported_isas();
+        for texture in [
+            noise_texture(16, 8, ColorSpace::Srgb),
+            noise_texture(7, 5, ColorSpace::Srgb),
+        ] {
+            assert!(matches!(texture.lane_texels(), TexelSource::Linear16(_)));
+            for sampler in samplers() {
+                for query in queries(&mut rng, 6) {
+                    let kernel = |bytes| Sample {
+                        texture: &texture,
+                        sampler,
+                        query,
+                        bytes,
+                    };
+                    let copy = dispatch(Isa::Scalar, kernel(false));
+                    for &isa in &isas {
+                        for bytes in [false, true] {
+                            let got = dispatch(isa, kernel(bytes));
+                            assert!(
+                                got.map(|c| c.map(f32::to_bits))
+                                    == copy.map(|c| c.map(f32::to_bits)),
+                                "{isa}, bytes {bytes}: {sampler:?} {query:?}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Only sRGB textures up to 2048 × 2048 keep a decoded copy (8 bytes a texel).
+    #[test]
+    fn decoded_copy_is_kept_for_small_srgb_textures_only() {
+        let srgb = noise_texture(4, 4, ColorSpace::Srgb);
+        let before = srgb.memory_bytes();
+        srgb.prepare_lane_sampling();
+        assert_eq!(
+            srgb.linear16().map(<[u32]>::len),
+            Some(2 * srgb.texels.len())
+        );
+        assert_eq!(srgb.memory_bytes() - before, 8 * srgb.texels.len());
+        let linear = noise_texture(4, 4, ColorSpace::Linear);
+        linear.prepare_lane_sampling();
+        assert!(linear.linear16().is_none());
+        let wide = Texture::from_rgba8(4097, 1024, &vec![7; 4097 * 1024 * 4], ColorSpace::Srgb)
+            .expect("texture");
+        assert!(wide.linear16().is_none());
+        assert!(matches!(wide.lane_texels(), TexelSource::SrgbBytes(..)));
+    }
+
     #[test]
     fn nan_and_huge_coordinates_are_defined() {
         let texture = noise_texture(8, 8, ColorSpace::Srgb);
@@ -739,6 +880,7 @@ mod tests {
                         texture: &texture,
                         sampler,
                         query,
+                        bytes: false,
                     },
                 );
                 for (k, uv) in query.uv.iter().enumerate() {
@@ -770,6 +912,7 @@ mod tests {
                 texture: &texture,
                 sampler: Sampler::default(),
                 query,
+                bytes: false,
             },
         );
         assert_eq!(got, [[0.0; 8]; 4]);

@@ -62,6 +62,35 @@ pub fn decode_table(color_space: ColorSpace) -> &'static [u32; 256] {
     }
 }
 
+/// The linear value of an sRGB byte in 16-bit units, `round(srgb_to_linear(k / 255) · 65535)`:
+/// what the lane-wide sampler filters for the red, green and blue channels of sRGB textures (as
+/// integers in `f32`, divided by 65535 once after filtering). Every byte survives the round trip
+/// through it back to 8-bit sRGB.
+#[inline]
+pub fn srgb_to_linear16(k: u8) -> u16 {
+    (srgb_to_linear(k as f32 / 255.0) * 65535.0).round() as u16
+}
+
+/// [`srgb_to_linear16`] of every byte as the `f32` bit patterns of those integers, for the
+/// lane-wide sampler's gathers. Built once per process.
+pub fn linear16_table() -> &'static [u32; 256] {
+    static TABLE: OnceLock<[u32; 256]> = OnceLock::new();
+    TABLE.get_or_init(|| std::array::from_fn(|k| (srgb_to_linear16(k as u8) as f32).to_bits()))
+}
+
+/// An sRGB texel decoded to 16 bits per channel, as two words `[r | g << 16, b | a << 16]`:
+/// red, green and blue by [`srgb_to_linear16`], alpha (linear) as `a · 257` (`a / 255` in units
+/// of 1/65535, exactly).
+#[inline]
+pub fn srgb_texel_to_linear16(texel: u32) -> [u32; 2] {
+    let [r, g, b, a] = unpack_rgba8(texel);
+    let word = |low: u16, high: u16| low as u32 | (high as u32) << 16;
+    [
+        word(srgb_to_linear16(r), srgb_to_linear16(g)),
+        word(srgb_to_linear16(b), a as u16 * 257),
+    ]
+}
+
 /// `k / 255`, the linear value of an 8-bit unsigned normalised byte.
 #[inline]
 fn unorm_to_f32(k: u8) -> f32 {
@@ -92,6 +121,26 @@ mod tests {
             let decoded = f32::from_bits(srgb[k as usize]);
             assert_eq!(unorm8(linear_to_srgb(decoded)), k);
         }
+    }
+
+    #[test]
+    fn sixteen_bit_decoding_keeps_every_byte() {
+        let table = linear16_table();
+        let mut previous = -1.0f32;
+        for k in 0..=255u8 {
+            let value = f32::from_bits(table[k as usize]);
+            assert_eq!(value, srgb_to_linear16(k) as f32);
+            assert!(value > previous, "increasing at {k}");
+            previous = value;
+            // Within half a unit of the exact decode, and back to the same byte.
+            let exact = srgb_to_linear(k as f32 / 255.0) * 65535.0;
+            assert!((value - exact).abs() <= 0.5, "{k}: {value} vs {exact}");
+            assert_eq!(unorm8(linear_to_srgb(value / 65535.0)), k);
+        }
+        assert_eq!(srgb_to_linear16(255), 65535);
+        let [rg, ba] = srgb_texel_to_linear16(pack_rgba8([255, 0, 188, 128]));
+        assert_eq!(rg, 65535);
+        assert_eq!(ba, srgb_to_linear16(188) as u32 | (128 * 257) << 16);
     }
 
     #[test]

@@ -12,16 +12,28 @@
 //! Two samplers read that storage: the scalar [`Texture::sample_grad`] / [`Texture::sample_lod`]
 //! (for user shaders, one pixel at a time) and the lane-wide [`Texture::sample_grad_lanes`]
 //! (eight pixels at a time, used by the built-in materials). They apply the same rules; their
-//! results may differ in the last bits (the lane sampler computes `log2` with a polynomial and
-//! filters linear channels before dividing by 255).
+//! results may differ in the last bits (the lane sampler computes `log2` with a polynomial,
+//! filters linear channels as bytes and sRGB channels as 16-bit linear values, and scales them
+//! to [0, 1] after filtering). The lane sampler keeps a small sRGB texture's texels decoded to
+//! those 16-bit values (8 bytes a texel, built once: [`Texture::prepare_lane_sampling`]), so it
+//! reads them without a table lookup per channel; larger ones (level 0 over 2048 × 2048) keep to
+//! 4 bytes a texel and the table.
+
+use std::sync::OnceLock;
 
 use glam::{Vec2, Vec4};
 
-use super::texel::{decode_table, decode_texel, encode_texel, pack_rgba8, unpack_rgba8};
+use super::texel::{
+    decode_table, decode_texel, encode_texel, pack_rgba8, srgb_texel_to_linear16, unpack_rgba8,
+};
 use crate::error::RenderError;
 
 /// Largest texture side accepted (texels).
 pub const MAX_TEXTURE_SIZE: u32 = 16384;
+
+/// Largest level 0 (texels) of an sRGB texture whose texels the lane-wide sampler keeps decoded
+/// to 16 bits ([`Texture::prepare_lane_sampling`]): 2048 × 2048, a copy of at most 45 MB.
+const LINEAR16_MAX_TEXELS: usize = 2048 * 2048;
 
 /// How the 8-bit channels of an image are encoded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,6 +91,10 @@ pub struct Texture {
     pub(super) texels: Vec<u32>,
     pub(super) levels: LevelTable,
     pub(super) color_space: ColorSpace,
+    /// An sRGB texture's texels decoded to 16 bits per channel, two words per texel
+    /// ([`srgb_texel_to_linear16`]), same layout as `texels`: built on first use by the lane-wide
+    /// sampler, for textures up to [`LINEAR16_MAX_TEXELS`] (see [`Texture::linear16`]).
+    linear16: OnceLock<Vec<u32>>,
 }
 
 impl std::fmt::Debug for Texture {
@@ -163,7 +179,33 @@ impl Texture {
             texels,
             levels,
             color_space,
+            linear16: OnceLock::new(),
         }
+    }
+
+    /// Decodes an sRGB texture's texels for the lane-wide sampler now rather than on its first
+    /// use ([`Texture::sample_grad_lanes`] reads them, when the texture is small enough, instead
+    /// of decoding each texel through a table; the results are the same). Backends that sample
+    /// lane-wide call it when a scene is loaded, so that no frame pays for it.
+    pub fn prepare_lane_sampling(&self) {
+        let _ = self.linear16();
+    }
+
+    /// The texels decoded to 16 bits (two words per texel, [`srgb_texel_to_linear16`]) for an
+    /// sRGB texture whose level 0 holds at most [`LINEAR16_MAX_TEXELS`] texels, built on first
+    /// use; `None` for linear and larger textures.
+    pub(super) fn linear16(&self) -> Option<&[u32]> {
+        let small = self.width() as usize * self.height() as usize <= LINEAR16_MAX_TEXELS;
+        if self.color_space != ColorSpace::Srgb || !small {
+            return None;
+        }
+        let words = self.linear16.get_or_init(|| {
+            self.texels
+                .iter()
+                .flat_map(|&t| srgb_texel_to_linear16(t))
+                .collect()
+        });
+        Some(words)
     }
 
     /// Width of level 0 in texels.
@@ -204,10 +246,12 @@ impl Texture {
         self.color_space
     }
 
-    /// Bytes of memory the texture holds: the texels of every level and the level table.
+    /// Bytes of memory the texture holds: the texels of every level, the level table and, once
+    /// built, the lane-wide sampler's decoded copy ([`Texture::prepare_lane_sampling`]).
     pub fn memory_bytes(&self) -> usize {
+        let decoded = self.linear16.get().map_or(0, Vec::capacity);
         std::mem::size_of::<Self>()
-            + self.texels.capacity() * std::mem::size_of::<u32>()
+            + (self.texels.capacity() + decoded) * std::mem::size_of::<u32>()
             + 3 * self.levels.offsets.capacity() * std::mem::size_of::<u32>()
     }
 
@@ -648,7 +692,9 @@ mod tests {
     fn a_4096_texture_with_mips_fits_in_96_mb() {
         let size = 4096u32;
         let rgba = vec![200u8; (size * size * 4) as usize];
-        let t = Texture::from_rgba8(size, size, &rgba, ColorSpace::Linear).expect("texture");
+        // sRGB, prepared for the lane-wide sampler: too large for a decoded copy.
+        let t = Texture::from_rgba8(size, size, &rgba, ColorSpace::Srgb).expect("texture");
+        t.prepare_lane_sampling();
         assert_eq!(t.level_count(), 13);
         let texels: usize = t.levels().map(|l| l.texels.len()).sum();
         assert_eq!(texels, 22_369_621); // (4^13 − 1) / 3
