@@ -184,15 +184,17 @@ impl Texture {
     ) -> Channels<L> {
         let lanes = nearest.lanes();
         let (offset, width, height) = self.level_extents::<L>(level, live);
+        // Every level of a texture whose level 0 has power-of-two sides has them too.
+        let pot = self.width().is_power_of_two() && self.height().is_power_of_two();
         let s = LaneAxis::<L>::new(sampler.wrap_s, uv[0], width);
         let t = LaneAxis::<L>::new(sampler.wrap_t, uv[1], height);
         if nearest.all() {
             let i = sampler
                 .wrap_s
-                .wrap_lanes::<L>(s.coord.to_i32_floor(), width);
+                .wrap_lanes::<L>(s.coord.to_i32_floor(), width, pot);
             let j = sampler
                 .wrap_t
-                .wrap_lanes::<L>(t.coord.to_i32_floor(), height);
+                .wrap_lanes::<L>(t.coord.to_i32_floor(), height, pot);
             return fetch_lanes::<L>(source, offset + j * width + i);
         }
         // Bilinear: texel centres at integer + ½. A nearest lane reads texel ⌊u⌋ with weights
@@ -205,10 +207,10 @@ impl Texture {
         let beta = nearest.select_f32(zero, vs - j0f);
         let (i0, j0) = (i0f.to_i32_trunc(), j0f.to_i32_trunc());
         let one = lanes.splat_i32(1);
-        let x0 = sampler.wrap_s.wrap_lanes::<L>(i0, width);
-        let x1 = sampler.wrap_s.wrap_lanes::<L>(i0 + one, width);
-        let row0 = offset + sampler.wrap_t.wrap_lanes::<L>(j0, height) * width;
-        let row1 = offset + sampler.wrap_t.wrap_lanes::<L>(j0 + one, height) * width;
+        let x0 = sampler.wrap_s.wrap_lanes::<L>(i0, width, pot);
+        let x1 = sampler.wrap_s.wrap_lanes::<L>(i0 + one, width, pot);
+        let row0 = offset + sampler.wrap_t.wrap_lanes::<L>(j0, height, pot) * width;
+        let row1 = offset + sampler.wrap_t.wrap_lanes::<L>(j0 + one, height, pot) * width;
         let (one_alpha, one_beta) = (lanes.splat_f32(1.0) - alpha, lanes.splat_f32(1.0) - beta);
         // Each row's two texels are blended as soon as they are fetched, so only one row's
         // texels are live at a time (four texels of four channels would not fit the registers).
@@ -475,12 +477,15 @@ impl<L: Lanes> LaneAxis<L> {
 impl Wrap {
     /// [`Wrap::apply`] on lanes, for the integer coordinates [`LaneAxis`] produces: in
     /// `[−1, size]` for REPEAT, `[−1, 2·size]` for MIRRORED_REPEAT, anything for CLAMP_TO_EDGE.
+    /// `pot`: every lane's `size` is a power of two, where REPEAT is one mask (`i & (size − 1)`,
+    /// the same result on that range, and the same `1` for `size + 1` when `size ≥ 2`).
     #[inline(always)]
-    fn wrap_lanes<L: Lanes>(self, i: L::I32, size: L::I32) -> L::I32 {
+    fn wrap_lanes<L: Lanes>(self, i: L::I32, size: L::I32, pot: bool) -> L::I32 {
         let lanes = i.lanes();
         let zero = lanes.splat_i32(0);
         let one = lanes.splat_i32(1);
         match self {
+            Wrap::Repeat if pot => i & (size - one),
             Wrap::Repeat => {
                 let i = i.simd_lt(zero).select_i32(i + size, i);
                 i.simd_gt(size - one).select_i32(i - size, i)
