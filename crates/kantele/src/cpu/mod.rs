@@ -268,6 +268,7 @@ mod tests {
             "the mirrored quad must be drawn, not culled"
         );
     }
+
     /// Without vertex colours the base colour is the factor exactly (no interpolated white,
     /// whose weights need not sum to exactly 1); with white vertex colours it is within rounding.
     #[test]

@@ -3,14 +3,14 @@
 //!
 //! The rules are those of the scalar sampler ([`Texture::sample_lod`]): the level of detail per
 //! lane from the analytic derivatives (OpenGL 4.6 §8.14), magnification or minification per
-//! lane, every wrap mode and every filter. Texels are fetched with [`I32x8::gather_u32`] (each
-//! lane's level offset and size gathered from the level table), or, where the two columns of
-//! every lane's bilinear footprint are neighbours in memory, one row's two texels at once with
-//! [`TexelGather::gather_u32_pair`]. sRGB textures are filtered in 16-bit linear units
+//! lane, every wrap mode and every filter. Texels are read through a [`TexelSource`]
+//! ([`texel_lanes`](super::texel_lanes)): one per lane, or, where the two columns of every
+//! lane's bilinear footprint are neighbours in memory, one row's two texels at once (each lane's
+//! level offset and size gathered from the level table when the lanes' levels differ). sRGB
+//! textures are filtered in 16-bit linear units
 //! ([`srgb_to_linear16`](super::texel::srgb_to_linear16)): read from the texture's decoded copy
-//! (two words per texel, one 8-byte read) when it has one, otherwise decoded lane-wide from the
-//! bytes through the 256-entry table of the same values ([`TexelGather::lookup_rgb`]) — the two
-//! give the same bits.
+//! when it has one, otherwise decoded lane-wide from the bytes through the 256-entry table of the
+//! same values — the two give the same bits.
 //! Every step is the same `f32` / `i32` operation in the same order on every instruction set (no
 //! fused multiply-add), so the scalar build and the SIMD builds give identical bits.
 //!
@@ -19,27 +19,11 @@
 //! and scaled by 1/255 once at the end, and sRGB textures as 16-bit linear values (red, green
 //! and blue within half a unit of 1/65535 of the exact decode) scaled by 1/65535 at the end.
 
-use crate::simd::{F32x8, I32x8, Lanes, Mask8, MaskOf, TexelGather};
+use crate::simd::{F32x8, I32x8, Lanes, Mask8, MaskOf};
 
 use super::texel::linear16_table;
+use super::texel_lanes::{Channels, TexelSource};
 use super::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
-
-/// One lane value per texel channel, in the units of its [`TexelSource`]: 16-bit linear units for
-/// sRGB textures, raw bytes for linear ones.
-type Channels<L> = [<L as Lanes>::F32; 4];
-
-/// Where the sampler reads a texture's texels, and how it unpacks them to [`Channels`].
-#[derive(Clone, Copy)]
-enum TexelSource<'t> {
-    /// A linear texture's packed bytes, every channel as its raw byte value (0–255).
-    LinearBytes(&'t [u32]),
-    /// An sRGB texture's packed bytes: red, green and blue decoded through the table of 16-bit
-    /// linear values ([`linear16_table`]), alpha as `a · 257`.
-    SrgbBytes(&'t [u32], &'t [u32; 256]),
-    /// An sRGB texture's decoded copy: two words per texel, `[r | g << 16, b | a << 16]`, the same
-    /// values as `SrgbBytes` gives.
-    Linear16(&'t [u32]),
-}
 
 impl Texture {
     /// Samples eight texture coordinates at once, each with the level of detail from its own
@@ -122,10 +106,7 @@ impl Texture {
         }
         // Bytes or 16-bit units to [0, 1], multiplied by the reciprocal (a division per channel
         // would cost more than the rest of the step; the full-scale value still gives 1 exactly).
-        let scale = lanes.splat_f32(match self.color_space {
-            ColorSpace::Srgb => 1.0 / 65535.0,
-            ColorSpace::Linear => 1.0 / 255.0,
-        });
+        let scale = lanes.splat_f32(source.unit());
         for channel in &mut texel {
             *channel = *channel * scale;
         }
@@ -195,7 +176,7 @@ impl Texture {
             let j = sampler
                 .wrap_t
                 .wrap_lanes::<L>(t.coord.to_i32_floor(), height, pot);
-            return fetch_lanes::<L>(source, offset + j * width + i);
+            return source.fetch::<L>(offset + j * width + i);
         }
         // Bilinear: texel centres at integer + ½. A nearest lane reads texel ⌊u⌋ with weights
         // (1, 0): t00·1 + t10·0 = t00 exactly, the nearest result.
@@ -218,20 +199,14 @@ impl Texture {
         // the common case), each row's pair of texels is one 8-byte read per lane.
         let neighbours = x1.simd_eq(x0 + one).or(live.not()).all();
         let (top, bottom) = if neighbours {
-            let (t00, t10) = fetch_pair_lanes::<L>(source, row0 + x0);
+            let (t00, t10) = source.fetch_pair::<L>(row0 + x0);
             let top = lerp_channels::<L>(&t00, &t10, one_alpha, alpha);
-            let (t01, t11) = fetch_pair_lanes::<L>(source, row1 + x0);
+            let (t01, t11) = source.fetch_pair::<L>(row1 + x0);
             (top, lerp_channels::<L>(&t01, &t11, one_alpha, alpha))
         } else {
-            let (t00, t10) = (
-                fetch_lanes::<L>(source, row0 + x0),
-                fetch_lanes::<L>(source, row0 + x1),
-            );
+            let (t00, t10) = (source.fetch::<L>(row0 + x0), source.fetch::<L>(row0 + x1));
             let top = lerp_channels::<L>(&t00, &t10, one_alpha, alpha);
-            let (t01, t11) = (
-                fetch_lanes::<L>(source, row1 + x0),
-                fetch_lanes::<L>(source, row1 + x1),
-            );
+            let (t01, t11) = (source.fetch::<L>(row1 + x0), source.fetch::<L>(row1 + x1));
             (top, lerp_channels::<L>(&t01, &t11, one_alpha, alpha))
         };
         lerp_channels::<L>(&top, &bottom, one_beta, beta)
@@ -262,94 +237,6 @@ impl Texture {
             ),
         }
     }
-}
-
-/// Gathers the texels at `index` from `source` and unpacks them.
-#[inline(always)]
-fn fetch_lanes<L: Lanes>(source: TexelSource<'_>, index: L::I32) -> Channels<L> {
-    match source {
-        TexelSource::LinearBytes(texels) => unpack_bytes::<L>(None, index.gather_u32(texels)),
-        TexelSource::SrgbBytes(texels, table) => {
-            unpack_bytes::<L>(Some(table), index.gather_u32(texels))
-        }
-        TexelSource::Linear16(words) => {
-            let (rg, ba) = (index + index).gather_u32_pair(words);
-            unpack_words::<L>(rg, ba)
-        }
-    }
-}
-
-/// The texels at `index` and `index + 1` from `source` (one 8-byte read per lane and texel of
-/// bytes, one 16-byte read in two halves of a decoded copy), unpacked. `index + 1` must lie in
-/// the texture's storage for live lanes.
-#[inline(always)]
-fn fetch_pair_lanes<L: Lanes>(
-    source: TexelSource<'_>,
-    index: L::I32,
-) -> (Channels<L>, Channels<L>) {
-    match source {
-        TexelSource::LinearBytes(texels) => {
-            let (first, second) = index.gather_u32_pair(texels);
-            (
-                unpack_bytes::<L>(None, first),
-                unpack_bytes::<L>(None, second),
-            )
-        }
-        TexelSource::SrgbBytes(texels, table) => {
-            let (first, second) = index.gather_u32_pair(texels);
-            (
-                unpack_bytes::<L>(Some(table), first),
-                unpack_bytes::<L>(Some(table), second),
-            )
-        }
-        TexelSource::Linear16(words) => {
-            let word = index + index;
-            let (rg0, ba0) = word.gather_u32_pair(words);
-            let (rg1, ba1) = (word + word.lanes().splat_i32(2)).gather_u32_pair(words);
-            (unpack_words::<L>(rg0, ba0), unpack_words::<L>(rg1, ba1))
-        }
-    }
-}
-
-/// Unpacks packed texels: red, green and blue through `table` (16-bit linear values, an sRGB
-/// texture) with alpha as `a · 257`, or (`None`, a linear texture) every channel as its raw byte
-/// value (0–255).
-#[inline(always)]
-fn unpack_bytes<L: Lanes>(table: Option<&[u32; 256]>, texel: L::I32) -> Channels<L> {
-    let lanes = texel.lanes();
-    let a = texel.shr_logical::<24>().to_f32();
-    match table {
-        Some(table) => {
-            let [r, g, b] = texel.lookup_rgb(table);
-            [
-                L::F32::from_bits(r),
-                L::F32::from_bits(g),
-                L::F32::from_bits(b),
-                a * lanes.splat_f32(257.0),
-            ]
-        }
-        None => {
-            let byte = lanes.splat_i32(0xff);
-            [
-                (texel & byte).to_f32(),
-                (texel.shr_logical::<8>() & byte).to_f32(),
-                (texel.shr_logical::<16>() & byte).to_f32(),
-                a,
-            ]
-        }
-    }
-}
-
-/// Unpacks decoded texels, the words `rg = r | g << 16` and `ba = b | a << 16`, to 16-bit units.
-#[inline(always)]
-fn unpack_words<L: Lanes>(rg: L::I32, ba: L::I32) -> Channels<L> {
-    let low = rg.lanes().splat_i32(0xffff);
-    [
-        (rg & low).to_f32(),
-        rg.shr_logical::<16>().to_f32(),
-        (ba & low).to_f32(),
-        ba.shr_logical::<16>().to_f32(),
-    ]
 }
 
 /// `a·keep + b·weight` per channel (one bilinear step: `keep = 1 − weight`). A plain loop, not
