@@ -10,7 +10,10 @@ use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 
 use crate::backend::Pass;
 use crate::camera::normal_matrix;
-use crate::pipeline::{Fragment, FragmentLanes, RenderState, ShadedLanes, Shader};
+use crate::pipeline::{
+    Fragment, FragmentLanes, LaneProgram, LaneProgramJob, RenderState, ShadedLanes, Shader,
+    ShaderLanes,
+};
 use crate::rop::BlendMode;
 use crate::scene::{AlphaMode, Material, Mesh};
 use crate::setup::CullMode;
@@ -319,6 +322,49 @@ impl Shader for MaterialShader<'_> {
     #[inline(always)]
     fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
         self.shade_lanes(fragments)
+    }
+
+    /// Opaque untextured colour-pass draws run a program compiled for their lighting and vertex
+    /// colours ([`OpaqueUntextured`]); every other draw runs [`MaterialShader::shade_lanes`].
+    #[inline(always)]
+    fn with_lane_program<J: LaneProgramJob>(&self, job: J) -> J::Output {
+        let Some(program) = self.untextured_color else {
+            return job.run(&ShaderLanes(self));
+        };
+        if !matches!(program.alpha_mode, AlphaMode::Opaque) {
+            return job.run(&ShaderLanes(self));
+        }
+        let shader = self;
+        match (program.unlit, program.vertex_colors) {
+            (true, true) => job.run(&OpaqueUntextured::<true, true> { shader, program }),
+            (true, false) => job.run(&OpaqueUntextured::<true, false> { shader, program }),
+            (false, true) => job.run(&OpaqueUntextured::<false, true> { shader, program }),
+            (false, false) => job.run(&OpaqueUntextured::<false, false> { shader, program }),
+        }
+    }
+}
+
+/// The lane program of an opaque untextured colour-pass draw with lighting (`UNLIT`) and vertex
+/// colours (`VERTEX_COLORS`) fixed at compile time: [`MaterialShader::shade_untextured_color_lanes`]
+/// with those branches, and the alpha mode's, decided (the interpolation of an unused alpha
+/// varying disappears with them).
+struct OpaqueUntextured<'s, 'a, const UNLIT: bool, const VERTEX_COLORS: bool> {
+    shader: &'s MaterialShader<'a>,
+    program: UntexturedColor,
+}
+
+impl<const UNLIT: bool, const VERTEX_COLORS: bool> LaneProgram
+    for OpaqueUntextured<'_, '_, UNLIT, VERTEX_COLORS>
+{
+    #[inline(always)]
+    fn fragment_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+        let program = UntexturedColor {
+            unlit: UNLIT,
+            vertex_colors: VERTEX_COLORS,
+            alpha_mode: AlphaMode::Opaque,
+            ..self.program
+        };
+        self.shader.shade_untextured_color_lanes(f, &program)
     }
 }
 

@@ -13,7 +13,9 @@ use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::draw::{DrawCall, DrawJob};
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
-use super::shader::{vertex_varyings, FragmentLanes, Interpolation, Shader};
+use super::shader::{
+    vertex_varyings, FragmentLanes, Interpolation, LaneProgram, LaneProgramJob, Shader,
+};
 use crate::fixed::pixel_center;
 use crate::raster::bin::{TileBins, TriangleRef};
 use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
@@ -136,16 +138,43 @@ pub(super) fn shade_triangle<S: Shader>(
     tile: &mut TileBuffer,
     isa: Isa,
 ) -> RasterCounters {
-    dispatch(
+    draw.shader.with_lane_program(ShadeTriangleJob {
+        draw,
+        tri,
+        attrs,
+        coverage,
+        tile,
         isa,
-        ShadeTriangle {
-            draw,
-            tri,
-            attrs,
-            coverage,
-            tile,
-        },
-    )
+    })
+}
+
+/// [`shade_triangle`] waiting for the draw's lane program (see [`Shader::with_lane_program`]).
+struct ShadeTriangleJob<'k, 'a, S: Shader> {
+    draw: &'k DrawCall<'a, S>,
+    tri: &'k TriangleSetup,
+    attrs: &'k [f32],
+    coverage: &'k BlockCoverage,
+    tile: &'k mut TileBuffer,
+    isa: Isa,
+}
+
+impl<S: Shader> LaneProgramJob for ShadeTriangleJob<'_, '_, S> {
+    type Output = RasterCounters;
+
+    #[inline(always)]
+    fn run<P: LaneProgram>(self, program: &P) -> RasterCounters {
+        dispatch(
+            self.isa,
+            ShadeTriangle {
+                draw: self.draw,
+                program,
+                tri: self.tri,
+                attrs: self.attrs,
+                coverage: self.coverage,
+                tile: self.tile,
+            },
+        )
+    }
 }
 
 /// A triangle's per-pixel constants splatted across the lanes, and the steps every lane kernel
@@ -267,22 +296,24 @@ impl<L: Lanes> ClearLanes<L> {
     }
 }
 
-/// One triangle in one tile, as a kernel compiled per instruction set.
-struct ShadeTriangle<'k, 'a, S: Shader> {
+/// One triangle in one tile, as a kernel compiled per instruction set and lane program.
+struct ShadeTriangle<'k, 'a, S: Shader, P: LaneProgram> {
     draw: &'k DrawCall<'a, S>,
+    program: &'k P,
     tri: &'k TriangleSetup,
     attrs: &'k [f32],
     coverage: &'k BlockCoverage,
     tile: &'k mut TileBuffer,
 }
 
-impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
+impl<S: Shader, P: LaneProgram> LaneKernel for ShadeTriangle<'_, '_, S, P> {
     type Output = RasterCounters;
 
     #[inline(always)]
     fn run<L: Lanes>(self, lanes: L) -> RasterCounters {
         let ShadeTriangle {
             draw,
+            program,
             tri,
             attrs,
             coverage,
@@ -380,7 +411,7 @@ impl<S: Shader> LaneKernel for ShadeTriangle<'_, '_, S> {
                         w,
                         interpolation: &interpolation,
                     };
-                    let shaded = shader.fragment_lanes(&fragments);
+                    let shaded = program.fragment_lanes(&fragments);
                     let keep = active.and(shaded.keep);
                     let keep_bits = keep.bits();
                     if keep_bits == 0 {

@@ -29,7 +29,10 @@ use std::time::{Duration, Instant};
 use glam::Vec4;
 
 pub use self::draw::Indices;
-pub use self::shader::{FnShader, Fragment, FragmentLanes, ShadedLanes, Shader};
+pub use self::shader::{
+    FnShader, Fragment, FragmentLanes, LaneProgram, LaneProgramJob, ShadedLanes, Shader,
+    ShaderLanes,
+};
 pub use crate::state::{RenderState, Topology};
 
 use self::budget::FrameBudget;

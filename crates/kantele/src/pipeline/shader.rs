@@ -60,6 +60,47 @@ pub trait Shader: Send + Sync {
             keep: lanes.mask_from_bits(keep),
         }
     }
+
+    /// Runs `job` (the per-pixel work of one triangle) with the lane program this draw's
+    /// fragments are shaded by. The default hands over [`Shader::fragment_lanes`] itself; a
+    /// shader whose program branches on properties fixed for the whole draw (the built-in
+    /// materials: lit or unlit, vertex colours, alpha mode) overrides it to choose, once per
+    /// triangle, a program compiled with those branches decided, so that the per-row code holds
+    /// only the arithmetic. Whatever it chooses must shade exactly as `fragment_lanes` does.
+    #[inline(always)]
+    fn with_lane_program<J: LaneProgramJob>(&self, job: J) -> J::Output
+    where
+        Self: Sized,
+    {
+        job.run(&ShaderLanes(self))
+    }
+}
+
+/// A lane-wide fragment program, as the per-pixel kernel calls it for each row of eight pixels
+/// (see [`Shader::with_lane_program`]).
+pub trait LaneProgram: Sync {
+    /// Shades the active lanes of one row, as [`Shader::fragment_lanes`].
+    fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L>;
+}
+
+/// Work that runs with a draw's [`LaneProgram`], compiled once per program type (see
+/// [`Shader::with_lane_program`]). The renderer implements it; shaders only call
+/// [`LaneProgramJob::run`].
+pub trait LaneProgramJob {
+    /// What the work returns.
+    type Output;
+    /// Does the work with `program` shading the fragments.
+    fn run<P: LaneProgram>(self, program: &P) -> Self::Output;
+}
+
+/// A shader's own [`Shader::fragment_lanes`] as a [`LaneProgram`].
+pub struct ShaderLanes<'s, S>(pub &'s S);
+
+impl<S: Shader> LaneProgram for ShaderLanes<'_, S> {
+    #[inline(always)]
+    fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+        self.0.fragment_lanes(fragments)
+    }
 }
 
 /// A [`Shader`] made of two closures, for quick programs:
