@@ -121,7 +121,7 @@ pub trait Backend {
     fn renderer(&self) -> String;
     /// Threads the backend renders with (1 for a GPU driver).
     fn threads(&self) -> usize;
-    /// The instruction set of the backend's per-pixel path (`"avx2"`, `"scalar"`, …), or `"-"`
+    /// The instruction set of the backend's per-pixel path (`"avx512"`, `"avx2"`, `"scalar"`, …), or `"-"`
     /// where the question does not apply (a GPU driver).
     fn isa(&self) -> String {
         "-".to_string()

@@ -42,6 +42,32 @@ pub(super) fn run<K: LaneKernel>(token: Avx2, kernel: K) -> K::Output {
     unsafe { run_avx2(token, kernel) }
 }
 
+/// Whether this CPU has AVX-512F and AVX-512VL (runtime detection, cached by `std`), which
+/// [`run_avx512`] needs beside the AVX2 token.
+#[inline]
+pub(super) fn has_avx512() -> bool {
+    is_x86_feature_detected!("avx512f") && is_x86_feature_detected!("avx512vl")
+}
+
+/// Runs `kernel` with the AVX2 lanes compiled with AVX-512F and AVX-512VL enabled: the same
+/// 256-bit operations on the same lane types, encoded with EVEX and given 32 vector registers
+/// instead of 16 (fewer spills in kernels with many live values, such as the sampler). No
+/// 512-bit lane type exists and the `fma` feature stays off, so every result is the AVX2 one.
+/// On a CPU without AVX-512F and AVX-512VL it runs [`run`]'s AVX2 code.
+#[inline]
+pub(super) fn run_avx512<K: LaneKernel>(token: Avx2, kernel: K) -> K::Output {
+    #[target_feature(enable = "avx2,popcnt,avx512f,avx512vl")]
+    unsafe fn run_avx512_vl<K: LaneKernel>(token: Avx2, kernel: K) -> K::Output {
+        kernel.run(token)
+    }
+    if !has_avx512() {
+        return run(token, kernel);
+    }
+    // SAFETY: `token` exists, so AVX2 and `popcnt` were detected, and `has_avx512` detected
+    // AVX-512F and AVX-512VL on this CPU.
+    unsafe { run_avx512_vl(token, kernel) }
+}
+
 /// 8 × `f32` in a `__m256`.
 #[derive(Clone, Copy)]
 pub struct Avx2F32(__m256);

@@ -3,8 +3,9 @@
 //!
 //! The per-pixel path is written **once**, generic over a lane implementation ([`Lanes`]), and
 //! instantiated for every instruction set the crate knows ([`Isa`]): plain Rust ([`Scalar`], the
-//! readable reference and the fallback), SSE2 and SSE4.1 (`Sse2`, `Sse41`), AVX2 (`Avx2`) on
-//! x86-64 and NEON (`Neon`) on AArch64. A kernel is a type implementing [`LaneKernel`];
+//! readable reference and the fallback), SSE2 and SSE4.1 (`Sse2`, `Sse41`), AVX2 (`Avx2`, also
+//! compiled a second time with AVX-512F/VL code generation: [`Isa::Avx512`]) on x86-64 and NEON
+//! (`Neon`) on AArch64. A kernel is a type implementing [`LaneKernel`];
 //! [`dispatch`] runs it with the implementation of the requested level:
 //!
 //! ```
@@ -63,7 +64,7 @@
 //!
 //! The instruction set is chosen once per process by [`Isa::selected`]: the best one the CPU
 //! supports ([`Isa::best`]), or the one named by the environment variable `KANTELE_ISA`
-//! (`scalar`, `sse2`, `sse41`, `avx2`, `neon`) when that one is supported.
+//! (`scalar`, `sse2`, `sse41`, `avx2`, `avx512`, `neon`) when that one is supported.
 //!
 //! [`round_ties_even`] and [`floor`] are scalar helpers for code outside the lanes: the x86-64
 //! baseline turns `f32::round_ties_even` and `f32::floor` into libm calls, these use `roundss`
@@ -116,14 +117,24 @@ pub enum Isa {
     Avx2,
     /// AArch64 NEON (two 4-lane halves).
     Neon,
+    /// x86-64 with AVX-512F and AVX-512VL: the [`Isa::Avx2`] lanes (same 256-bit operations,
+    /// same results) compiled with EVEX encodings and 32 vector registers instead of 16.
+    Avx512,
 }
 
 impl Isa {
     /// Every level, in declaration order.
-    pub const ALL: [Isa; 5] = [Isa::Scalar, Isa::Sse2, Isa::Sse41, Isa::Avx2, Isa::Neon];
+    pub const ALL: [Isa; 6] = [
+        Isa::Scalar,
+        Isa::Sse2,
+        Isa::Sse41,
+        Isa::Avx2,
+        Isa::Neon,
+        Isa::Avx512,
+    ];
 
     /// The lower-case name used by `KANTELE_ISA`, [`Display`](fmt::Display) and
-    /// [`FromStr`]: `scalar`, `sse2`, `sse41`, `avx2` or `neon`.
+    /// [`FromStr`]: `scalar`, `sse2`, `sse41`, `avx2`, `avx512` or `neon`.
     pub fn name(self) -> &'static str {
         match self {
             Isa::Scalar => "scalar",
@@ -131,6 +142,16 @@ impl Isa {
             Isa::Sse41 => "sse41",
             Isa::Avx2 => "avx2",
             Isa::Neon => "neon",
+            Isa::Avx512 => "avx512",
+        }
+    }
+
+    /// The lane implementation this level runs ([`Lanes::isa`] of its kernels): the level
+    /// itself, except [`Isa::Avx512`], which compiles the [`Isa::Avx2`] lanes.
+    pub fn lanes(self) -> Isa {
+        match self {
+            Isa::Avx512 => Isa::Avx2,
+            isa => isa,
         }
     }
 
@@ -144,6 +165,8 @@ impl Isa {
             Isa::Sse41 => Sse41::new().is_some(),
             #[cfg(target_arch = "x86_64")]
             Isa::Avx2 => Avx2::new().is_some(),
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx512 => Avx2::new().is_some() && avx2::has_avx512(),
             #[cfg(target_arch = "aarch64")]
             Isa::Neon => Neon::new().is_some(),
             #[allow(unreachable_patterns)]
@@ -151,10 +174,10 @@ impl Isa {
         }
     }
 
-    /// The best level this CPU supports: AVX2, then SSE4.1, then SSE2 on x86-64; NEON on
-    /// AArch64; [`Isa::Scalar`] elsewhere.
+    /// The best level this CPU supports: AVX-512, then AVX2, SSE4.1 and SSE2 on x86-64; NEON
+    /// on AArch64; [`Isa::Scalar`] elsewhere.
     pub fn best() -> Isa {
-        [Isa::Avx2, Isa::Sse41, Isa::Sse2, Isa::Neon]
+        [Isa::Avx512, Isa::Avx2, Isa::Sse41, Isa::Sse2, Isa::Neon]
             .into_iter()
             .find(|isa| isa.is_supported())
             .unwrap_or(Isa::Scalar)
@@ -219,7 +242,7 @@ impl FromStr for Isa {
             .find(|isa| isa.name() == name)
             .ok_or_else(|| {
                 format!(
-                    "unknown instruction set `{s}` (expected one of scalar, sse2, sse41, avx2, neon)"
+                    "unknown instruction set `{s}` (expected one of scalar, sse2, sse41, avx2, avx512, neon)"
                 )
             })
     }
@@ -240,10 +263,16 @@ pub trait LaneKernel {
 ///
 /// `isa` must be supported by this CPU; an unsupported level (NEON on x86-64, AVX2 on a CPU
 /// without it) falls back to [`Isa::Scalar`]. The kernel can tell which implementation it got
-/// from [`Lanes::isa`].
+/// from [`Lanes::isa`] ([`Isa::Avx512`] runs the AVX2 lanes: see [`Isa::lanes`]).
 #[inline]
 pub fn dispatch<K: LaneKernel>(isa: Isa, kernel: K) -> K::Output {
     match isa {
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => {
+            if let Some(token) = Avx2::new().filter(|_| avx2::has_avx512()) {
+                return avx2::run_avx512(token, kernel);
+            }
+        }
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 => {
             if let Some(token) = Avx2::new() {

@@ -259,7 +259,8 @@ fn assert_same_as_scalar(inputs: &Inputs) {
         for ((name, want), (_, have)) in reference.iter().zip(&got) {
             if *name == "isa" {
                 assert_eq!(
-                    have[0], isa as u32,
+                    have[0],
+                    isa.lanes() as u32,
                     "{isa} kernel ran another implementation"
                 );
                 continue;
@@ -452,7 +453,7 @@ fn dispatch_runs_the_requested_isa_or_falls_back_to_scalar() {
     for isa in Isa::ALL {
         let ran = dispatch(isa, WhichIsa);
         if isa.is_supported() {
-            assert_eq!(ran, isa);
+            assert_eq!(ran, isa.lanes());
         } else {
             assert_eq!(
                 ran,
@@ -487,7 +488,16 @@ fn avx2_dispatch_runs_avx2_code_where_the_cpu_has_it() {
     );
     let expected = if has_avx2 { Isa::Avx2 } else { Isa::Scalar };
     assert_eq!(dispatch(Isa::Avx2, WhichIsa), expected);
-    if has_avx2 {
+    let has_avx512 = has_avx2
+        && std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512vl");
+    assert_eq!(Isa::Avx512.is_supported(), has_avx512);
+    // The AVX-512 level runs the AVX2 lanes.
+    let expected = if has_avx512 { Isa::Avx2 } else { Isa::Scalar };
+    assert_eq!(dispatch(Isa::Avx512, WhichIsa), expected);
+    if has_avx512 {
+        assert_eq!(Isa::best(), Isa::Avx512);
+    } else if has_avx2 {
         assert_eq!(Isa::best(), Isa::Avx2);
     }
 }
@@ -498,7 +508,7 @@ fn neon_dispatch_runs_neon_code() {
     assert!(Isa::Neon.is_supported(), "every AArch64 CPU has NEON");
     assert_eq!(dispatch(Isa::Neon, WhichIsa), Isa::Neon);
     assert_eq!(Isa::best(), Isa::Neon);
-    for isa in [Isa::Sse2, Isa::Sse41, Isa::Avx2] {
+    for isa in [Isa::Sse2, Isa::Sse41, Isa::Avx2, Isa::Avx512] {
         assert!(!isa.is_supported());
         assert_eq!(dispatch(isa, WhichIsa), Isa::Scalar);
     }
@@ -512,8 +522,8 @@ fn isa_names_round_trip() {
         assert_eq!(isa.name().to_uppercase().parse::<Isa>(), Ok(isa));
     }
     assert_eq!("sse4.1".parse::<Isa>(), Ok(Isa::Sse41));
-    let error = "avx512".parse::<Isa>().unwrap_err();
-    assert!(error.contains("`avx512`") && error.contains("scalar, sse2, sse41, avx2, neon"));
+    let error = "avx10".parse::<Isa>().unwrap_err();
+    assert!(error.contains("`avx10`") && error.contains("scalar, sse2, sse41, avx2, avx512, neon"));
 }
 
 #[test]
