@@ -17,6 +17,7 @@ use crate::pipeline::{
 use crate::rop::BlendMode;
 use crate::scene::{AlphaMode, Material, Mesh};
 use crate::setup::CullMode;
+use crate::shade::sample_lanes::TrilinearRepeat16;
 use crate::shade::texture::{Sampler, Texture};
 use crate::simd::{F32x8, Lanes, Mask8};
 
@@ -328,6 +329,15 @@ impl Shader for MaterialShader<'_> {
     /// colours ([`OpaqueUntextured`]); every other draw runs [`MaterialShader::shade_lanes`].
     #[inline(always)]
     fn with_lane_program<J: LaneProgramJob>(&self, job: J) -> J::Output {
+        if let Some(texture) = self.opaque_textured() {
+            let (shader, vertex_colors) = (self, self.layout.color);
+            return match (self.material.unlit, vertex_colors) {
+                (true, true) => job.run(&OpaqueTextured::<true, true> { shader, texture }),
+                (true, false) => job.run(&OpaqueTextured::<true, false> { shader, texture }),
+                (false, true) => job.run(&OpaqueTextured::<false, true> { shader, texture }),
+                (false, false) => job.run(&OpaqueTextured::<false, false> { shader, texture }),
+            };
+        }
         let Some(program) = self.untextured_color else {
             return job.run(&ShaderLanes(self));
         };
@@ -340,6 +350,73 @@ impl Shader for MaterialShader<'_> {
             (true, false) => job.run(&OpaqueUntextured::<true, false> { shader, program }),
             (false, true) => job.run(&OpaqueUntextured::<false, true> { shader, program }),
             (false, false) => job.run(&OpaqueUntextured::<false, false> { shader, program }),
+        }
+    }
+}
+
+impl<'a> MaterialShader<'a> {
+    /// The base colour texture of an opaque colour-pass draw without an emissive texture, when
+    /// it is sampled in the [`TrilinearRepeat16`] configuration ([`OpaqueTextured`] then shades
+    /// the draw).
+    fn opaque_textured(&self) -> Option<TrilinearRepeat16<'a>> {
+        let plain = self.pass == Pass::Color
+            && self.emissive_texture.is_none()
+            && matches!(self.material.alpha_mode, AlphaMode::Opaque);
+        let (texture, sampler) = self.texture.filter(|_| plain)?;
+        texture.trilinear_repeat16(&sampler)
+    }
+}
+
+/// The lane program of an opaque colour-pass draw whose base colour texture is sampled in the
+/// [`TrilinearRepeat16`] configuration, without an emissive texture, with lighting (`UNLIT`) and
+/// vertex colours (`VERTEX_COLORS`) fixed at compile time: the operations of
+/// [`MaterialShader::shade_lanes`] for such a draw, in the same order, with no branch on the
+/// material, the pass, the wrap modes, the filters or the texel storage.
+struct OpaqueTextured<'s, 'a, const UNLIT: bool, const VERTEX_COLORS: bool> {
+    shader: &'s MaterialShader<'a>,
+    texture: TrilinearRepeat16<'a>,
+}
+
+impl<const UNLIT: bool, const VERTEX_COLORS: bool> LaneProgram
+    for OpaqueTextured<'_, '_, UNLIT, VERTEX_COLORS>
+{
+    #[inline(always)]
+    fn fragment_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+        let (shader, lanes) = (self.shader, f.lanes);
+        let material = shader.material;
+        let factor = material.base_color_factor.to_array();
+        let mut base = factor_times_color_lanes(f, factor, VERTEX_COLORS);
+        let u = VaryingLayout::TEXCOORD;
+        let (du_dx, du_dy) = f.derivatives(u);
+        let (dv_dx, dv_dy) = f.derivatives(u + 1);
+        let texel = self.texture.sample_grad_lanes::<L>(
+            [f.varying(u), f.varying(u + 1)],
+            [du_dx, dv_dx],
+            [du_dy, dv_dy],
+            f.active,
+        );
+        for c in 0..3 {
+            base[c] = base[c] * texel[c];
+        }
+        let e = material.emissive;
+        let emissive = [
+            lanes.splat_f32(e.x),
+            lanes.splat_f32(e.y),
+            lanes.splat_f32(e.z),
+        ];
+        let [r, g, b] = if UNLIT {
+            [
+                base[0] + emissive[0],
+                base[1] + emissive[1],
+                base[2] + emissive[2],
+            ]
+        } else {
+            let n = shader.normal_lanes(f, material.double_sided);
+            shader.lit_lanes(lanes, n, &base, emissive)
+        };
+        ShadedLanes {
+            color: [r, g, b, lanes.splat_f32(1.0)],
+            keep: lanes.mask_all(true),
         }
     }
 }

@@ -1,5 +1,5 @@
 //! Shading resources: textures, their 8-bit texel format and the samplers that read them.
-mod sample_lanes;
+pub(crate) mod sample_lanes;
 pub mod texel;
 mod texel_lanes;
 pub mod texture;

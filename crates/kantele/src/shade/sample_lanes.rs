@@ -42,7 +42,30 @@ impl Texture {
         duv_dy: [L::F32; 2],
         active: MaskOf<L>,
     ) -> [L::F32; 4] {
-        self.sample_grad_lanes_from::<L>(self.lane_texels(), sampler, uv, duv_dx, duv_dy, active)
+        let pot = self.width().is_power_of_two() && self.height().is_power_of_two();
+        self.sample_grad_lanes_from::<L>(
+            self.lane_texels(),
+            sampler,
+            pot,
+            uv,
+            duv_dx,
+            duv_dy,
+            active,
+        )
+    }
+
+    /// This texture and `sampler` as a [`TrilinearRepeat16`] when they are that configuration
+    /// (the one most textures are sampled with), else `None`.
+    pub(crate) fn trilinear_repeat16(&self, sampler: &Sampler) -> Option<TrilinearRepeat16<'_>> {
+        let configuration = *sampler == TrilinearRepeat16::SAMPLER
+            && self.width().is_power_of_two()
+            && self.height().is_power_of_two()
+            && self.color_space == ColorSpace::Srgb;
+        let words = self.linear16().filter(|_| configuration)?;
+        Some(TrilinearRepeat16 {
+            texture: self,
+            words,
+        })
     }
 
     /// Where [`Texture::sample_grad_lanes`] reads the texels: the decoded copy of an sRGB
@@ -55,12 +78,15 @@ impl Texture {
         }
     }
 
-    /// [`Texture::sample_grad_lanes`] reading `source`.
+    /// [`Texture::sample_grad_lanes`] reading `source`; `pot`: both sides of level 0 are powers
+    /// of two (and so those of every level).
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn sample_grad_lanes_from<L: Lanes>(
         &self,
         source: TexelSource<'_>,
         sampler: &Sampler,
+        pot: bool,
         uv: [L::F32; 2],
         duv_dx: [L::F32; 2],
         duv_dy: [L::F32; 2],
@@ -93,13 +119,20 @@ impl Texture {
         };
         let nearest = selection.nearest;
         let first =
-            self.sample_level_lanes::<L>(sampler, source, selection.first, uv, nearest, live);
+            self.sample_level_lanes::<L>(sampler, source, pot, selection.first, uv, nearest, live);
         // The second level only where some live lane blends (trilinear between levels).
         let blend = selection.fraction.simd_gt(zero).and(live);
         let mut texel = first;
         if blend.any() {
-            let second =
-                self.sample_level_lanes::<L>(sampler, source, selection.second, uv, nearest, live);
+            let second = self.sample_level_lanes::<L>(
+                sampler,
+                source,
+                pot,
+                selection.second,
+                uv,
+                nearest,
+                live,
+            );
             // A lane with fraction 0 keeps `first` exactly: a·1 + b·0 = a for finite b ≥ 0.
             let keep = lanes.splat_f32(1.0) - selection.fraction;
             texel = lerp_channels::<L>(&first, &second, keep, selection.fraction);
@@ -152,12 +185,14 @@ impl Texture {
 
     /// Filters one level per lane (`level` holds each lane's level index) at `uv`, nearest where
     /// `nearest` is set and bilinear elsewhere, reading `source`; lanes outside `live` are
-    /// unspecified. Returns [`Channels`].
+    /// unspecified; `pot` as in [`Texture::sample_grad_lanes_from`]. Returns [`Channels`].
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn sample_level_lanes<L: Lanes>(
         &self,
         sampler: &Sampler,
         source: TexelSource<'_>,
+        pot: bool,
         level: L::I32,
         uv: [L::F32; 2],
         nearest: MaskOf<L>,
@@ -165,8 +200,6 @@ impl Texture {
     ) -> Channels<L> {
         let lanes = nearest.lanes();
         let (offset, width, height) = self.level_extents::<L>(level, live);
-        // Every level of a texture whose level 0 has power-of-two sides has them too.
-        let pot = self.width().is_power_of_two() && self.height().is_power_of_two();
         let s = LaneAxis::<L>::new(sampler.wrap_s, uv[0], width);
         let t = LaneAxis::<L>::new(sampler.wrap_t, uv[1], height);
         if nearest.all() {
@@ -236,6 +269,48 @@ impl Texture {
                 level.gather_u32(&table.heights),
             ),
         }
+    }
+}
+
+/// An sRGB texture with a decoded copy and power-of-two sides, sampled with REPEAT on both
+/// axes, LINEAR magnification and LINEAR_MIPMAP_LINEAR minification ([`Self::SAMPLER`]): the
+/// glTF default most files use. [`TrilinearRepeat16::sample_grad_lanes`] is
+/// [`Texture::sample_grad_lanes`] with that configuration fixed at compile time, so that a
+/// program built on it holds none of the branches on wrap modes, filters and texel storage.
+#[derive(Clone, Copy)]
+pub(crate) struct TrilinearRepeat16<'t> {
+    texture: &'t Texture,
+    /// The texture's decoded copy ([`Texture::linear16`]).
+    words: &'t [u32],
+}
+
+impl TrilinearRepeat16<'_> {
+    /// The sampler of this configuration.
+    pub(crate) const SAMPLER: Sampler = Sampler {
+        wrap_s: Wrap::Repeat,
+        wrap_t: Wrap::Repeat,
+        mag_filter: Filter::Linear,
+        min_filter: MinFilter::LinearMipmapLinear,
+    };
+
+    /// [`Texture::sample_grad_lanes`] with [`Self::SAMPLER`]: the same operations, the same bits.
+    #[inline(always)]
+    pub(crate) fn sample_grad_lanes<L: Lanes>(
+        &self,
+        uv: [L::F32; 2],
+        duv_dx: [L::F32; 2],
+        duv_dy: [L::F32; 2],
+        active: MaskOf<L>,
+    ) -> [L::F32; 4] {
+        self.texture.sample_grad_lanes_from::<L>(
+            TexelSource::Linear16(self.words),
+            &Self::SAMPLER,
+            true,
+            uv,
+            duv_dx,
+            duv_dy,
+            active,
+        )
     }
 }
 
@@ -481,6 +556,8 @@ mod tests {
                 .sample_grad_lanes_from::<L>(
                     source,
                     &self.sampler,
+                    self.texture.width().is_power_of_two()
+                        && self.texture.height().is_power_of_two(),
                     pair(q.uv),
                     pair(q.duv_dx),
                     pair(q.duv_dy),
