@@ -750,3 +750,145 @@ fn sample(
         Vec2::new(du_dy, dv_dy),
     )
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::pipeline::{Indices, Renderer, RendererOptions};
+    use crate::scene::Topology;
+    use crate::shade::texture::ColorSpace;
+
+    /// A built-in shader with the default lane program only: its own `fragment_lanes`, never a
+    /// specialised program.
+    struct GeneralProgram<'s, 'a>(&'s MaterialShader<'a>);
+
+    impl Shader for GeneralProgram<'_, '_> {
+        type Vertex = StandardVertex;
+        fn varying_count(&self) -> usize {
+            self.0.varying_count()
+        }
+        fn vertex(&self, vertex: &StandardVertex, varyings: &mut [f32]) -> Vec4 {
+            self.0.vertex(vertex, varyings)
+        }
+        fn fragment(&self, fragment: &Fragment<'_>) -> Option<Vec4> {
+            self.0.fragment(fragment)
+        }
+        fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+            self.0.fragment_lanes(fragments)
+        }
+    }
+
+    /// The colour bits of a 96 × 64 frame of `mesh` drawn with `shader`.
+    fn render<S: Shader<Vertex = StandardVertex>>(shader: &S, mesh: &Mesh) -> Vec<u32> {
+        let (vertices, indices) = StandardVertex::from_mesh(mesh);
+        let mut renderer = Renderer::new(96, 64, RendererOptions::default()).expect("renderer");
+        let mut frame = renderer.begin_frame(Some(Vec4::new(0.1, 0.2, 0.3, 1.0)), Some(1.0));
+        let state = RenderState {
+            cull: CullMode::None,
+            ..RenderState::default()
+        };
+        frame
+            .draw_primitives(
+                shader,
+                &vertices,
+                Indices::U32(&indices),
+                Topology::Triangles,
+                state,
+            )
+            .expect("draw");
+        frame.try_end().expect("frame");
+        let color = renderer.framebuffer().read_color();
+        color.iter().flatten().map(|v| v.to_bits()).collect()
+    }
+
+    /// Every specialised lane program (untextured and textured, lit and unlit, with and without
+    /// vertex colours) gives the bits of the general program it replaces, on a receding quad
+    /// whose texture is magnified near the camera and minified (trilinear, repeating) far away.
+    #[test]
+    fn specialised_lane_programs_shade_as_the_general_one() {
+        let rgba: Vec<u8> = (0..64u32 * 64)
+            .flat_map(|i| {
+                let (x, y) = (i % 64, i / 64);
+                [(x * 4) as u8, (y * 4) as u8, ((x ^ y) * 4) as u8, 255]
+            })
+            .collect();
+        let texture = Texture::from_rgba8(64, 64, &rgba, ColorSpace::Srgb).expect("texture");
+        texture.prepare_lane_sampling();
+        let sampler = TrilinearRepeat16::SAMPLER;
+        let mesh = |colors: bool| Mesh {
+            positions: vec![
+                Vec3::new(-1.0, -0.6, 0.5),
+                Vec3::new(1.0, -0.6, 0.5),
+                Vec3::new(1.0, 0.4, -8.0),
+                Vec3::new(-1.0, 0.4, -8.0),
+            ],
+            normals: Some(vec![
+                Vec3::new(0.0, 1.0, 0.1),
+                Vec3::new(0.3, 1.0, 0.0),
+                Vec3::new(0.0, 1.0, -0.4),
+                Vec3::new(-0.2, 0.8, 0.0),
+            ]),
+            texcoords: Some(vec![
+                Vec2::new(0.0, 0.0),
+                Vec2::new(3.0, 0.0),
+                Vec2::new(3.0, 24.0),
+                Vec2::new(0.0, 24.0),
+            ]),
+            colors: colors.then(|| {
+                vec![
+                    Vec4::new(1.0, 0.5, 0.25, 1.0),
+                    Vec4::new(0.2, 1.0, 0.6, 0.5),
+                    Vec4::new(0.7, 0.3, 1.0, 1.0),
+                    Vec4::ONE,
+                ]
+            }),
+            indices: vec![0, 1, 2, 0, 2, 3],
+            ..Mesh::default()
+        };
+        let view_projection = Mat4::perspective_rh(1.0, 1.5, 0.1, 20.0)
+            * Mat4::look_at_rh(Vec3::new(0.0, 0.6, 1.6), Vec3::new(0.0, 0.0, -2.0), Vec3::Y);
+        let lighting = Lighting {
+            to_light: Vec3::new(0.3, 0.9, 0.3).normalize(),
+            light_color: Vec3::new(1.0, 0.95, 0.9),
+            ambient: 0.2,
+        };
+        for textured in [false, true] {
+            for unlit in [false, true] {
+                for colors in [false, true] {
+                    let material = Material {
+                        base_color_factor: Vec4::new(0.9, 0.8, 0.7, 1.0),
+                        unlit,
+                        emissive: Vec3::new(0.05, 0.0, 0.02),
+                        ..Material::default()
+                    };
+                    let shader = MaterialShader::new(
+                        Mat4::IDENTITY,
+                        view_projection,
+                        lighting,
+                        &material,
+                        textured.then_some((&texture, sampler)),
+                        Pass::Color,
+                        (1, 1),
+                    )
+                    .with_vertex_colors(colors);
+                    let case = format!("textured {textured}, unlit {unlit}, colours {colors}");
+                    // The draw does reach a specialised program.
+                    if textured {
+                        assert!(shader.opaque_textured().is_some(), "{case}");
+                    } else {
+                        assert!(shader.untextured_color.is_some(), "{case}");
+                    }
+                    let mesh = mesh(colors);
+                    let specialised = render(&shader, &mesh);
+                    let general = render(&GeneralProgram(&shader), &mesh);
+                    let drawn = specialised
+                        .chunks_exact(4)
+                        .filter(|c| c[2] != 0.3f32.to_bits())
+                        .count();
+                    assert!(drawn > 1000, "{case}: {drawn} pixels drawn");
+                    assert!(specialised == general, "{case}: the programs differ");
+                }
+            }
+        }
+    }
+}
