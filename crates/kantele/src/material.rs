@@ -325,8 +325,10 @@ impl Shader for MaterialShader<'_> {
         self.shade_lanes(fragments)
     }
 
-    /// Opaque untextured colour-pass draws run a program compiled for their lighting and vertex
-    /// colours ([`OpaqueUntextured`]); every other draw runs [`MaterialShader::shade_lanes`].
+    /// Opaque colour-pass draws without an emissive texture, untextured or with a base colour
+    /// texture sampled with the glTF default (REPEAT, LINEAR / LINEAR_MIPMAP_LINEAR, a
+    /// power-of-two sRGB texture), run a program compiled for their lighting and vertex colours
+    /// (`OpaqueUntextured`, `OpaqueTextured`); every other draw runs `fragment_lanes`.
     #[inline(always)]
     fn with_lane_program<J: LaneProgramJob>(&self, job: J) -> J::Output {
         if let Some(texture) = self.opaque_textured() {
