@@ -289,6 +289,9 @@ const _: () = assert!(TILE_SIZE <= 64);
 #[inline]
 fn scan_rows(rect: PixelRect, out: &mut BlockCoverage, mut row_bits: impl FnMut(i32) -> u64) {
     let block = BLOCK_SIZE as i32;
+    if rect.x1 - (rect.x0 & !(block - 1)) <= 2 * block {
+        return scan_rows_narrow(rect, out, row_bits);
+    }
     let tile_x = rect.x0 & !(TILE_SIZE as i32 - 1);
     // The rectangle's block columns, counted from the tile's left edge.
     let (bx0, bx1) = (
@@ -315,6 +318,40 @@ fn scan_rows(rect: PixelRect, out: &mut BlockCoverage, mut row_bits: impl FnMut(
         }
         for (bx, &mask) in masks.iter().enumerate().take(bx1).skip(bx0) {
             out.push(tile_x + ((bx as i32) << BLOCK_LOG2), block_y, mask);
+        }
+        y = band_end;
+    }
+}
+
+/// [`scan_rows`] for a rectangle within two block columns (most small triangles): a row's bits
+/// go to the two columns' masks by two shifts, with no loop over the row's blocks; the same
+/// blocks, appended in the same order.
+#[inline]
+fn scan_rows_narrow(
+    rect: PixelRect,
+    out: &mut BlockCoverage,
+    mut row_bits: impl FnMut(i32) -> u64,
+) {
+    let block = BLOCK_SIZE as i32;
+    // The first block column's left edge; bit `c` of a row's bits shifted by `offset` is column
+    // `c` from that edge (at most 16 bits: the rectangle ends within the second column).
+    let x_first = rect.x0 & !(block - 1);
+    let offset = (rect.x0 - x_first) as u32;
+    let two_columns = rect.x1 - x_first > block;
+    let mut y = rect.y0;
+    while y < rect.y1 {
+        let block_y = y & !(block - 1);
+        let band_end = (block_y + block).min(rect.y1);
+        let (mut left, mut right) = (0u64, 0u64);
+        for y in y..band_end {
+            let bits = row_bits(y) << offset;
+            let shift = ((y & (block - 1)) << BLOCK_LOG2) as u32;
+            left |= (bits & 0xff) << shift;
+            right |= ((bits >> 8) & 0xff) << shift;
+        }
+        out.push(x_first, block_y, left);
+        if two_columns {
+            out.push(x_first + block, block_y, right);
         }
         y = band_end;
     }
