@@ -163,17 +163,31 @@ impl<S: Shader> LaneProgramJob for ShadeTriangleJob<'_, '_, S> {
 
     #[inline(always)]
     fn run<P: LaneProgram>(self, program: &P) -> RasterCounters {
-        dispatch(
-            self.isa,
-            ShadeTriangle {
-                draw: self.draw,
-                program,
-                tri: self.tri,
-                attrs: self.attrs,
-                coverage: self.coverage,
-                tile: self.tile,
-            },
-        )
+        let state = &self.draw.state;
+        let opaque_less = state.depth_test
+            && state.depth_func == DepthFunc::Less
+            && state.depth_write
+            && state.blend == BlendMode::Replace;
+        macro_rules! shade {
+            ($opaque_less:literal) => {
+                dispatch(
+                    self.isa,
+                    ShadeTriangle::<S, P, $opaque_less> {
+                        draw: self.draw,
+                        program,
+                        tri: self.tri,
+                        attrs: self.attrs,
+                        coverage: self.coverage,
+                        tile: self.tile,
+                    },
+                )
+            };
+        }
+        if opaque_less {
+            shade!(true)
+        } else {
+            shade!(false)
+        }
     }
 }
 
@@ -296,8 +310,10 @@ impl<L: Lanes> ClearLanes<L> {
     }
 }
 
-/// One triangle in one tile, as a kernel compiled per instruction set and lane program.
-struct ShadeTriangle<'k, 'a, S: Shader, P: LaneProgram> {
+/// One triangle in one tile, as a kernel compiled per instruction set and lane program, and
+/// once more for the state of most draws (`OPAQUE_LESS`: depth test LESS with depth writes, no
+/// blending), whose per-row tests of that state are then decided at compile time.
+struct ShadeTriangle<'k, 'a, S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> {
     draw: &'k DrawCall<'a, S>,
     program: &'k P,
     tri: &'k TriangleSetup,
@@ -306,7 +322,9 @@ struct ShadeTriangle<'k, 'a, S: Shader, P: LaneProgram> {
     tile: &'k mut TileBuffer,
 }
 
-impl<S: Shader, P: LaneProgram> LaneKernel for ShadeTriangle<'_, '_, S, P> {
+impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> LaneKernel
+    for ShadeTriangle<'_, '_, S, P, OPAQUE_LESS>
+{
     type Output = RasterCounters;
 
     #[inline(always)]
@@ -341,10 +359,12 @@ impl<S: Shader, P: LaneProgram> LaneKernel for ShadeTriangle<'_, '_, S, P> {
         let depth_needs_range_test = !(tri.depth_range[0] >= 0.0 && tri.depth_range[1] <= 1.0);
         // Replace ignores the stored colour and passes the sanitised source through: nothing
         // to load, and nothing new to sanitise after blending.
-        let blend_reads_target = state.blend != BlendMode::Replace;
+        let blend_reads_target = !OPAQUE_LESS && state.blend != BlendMode::Replace;
+        let depth_test = OPAQUE_LESS || state.depth_test;
+        let depth_write = OPAQUE_LESS || state.depth_write;
         // LESS, every built-in material's test, is compared directly: the general function is a
         // jump table in the row loop.
-        let depth_less = state.depth_func == DepthFunc::Less;
+        let depth_less = OPAQUE_LESS || state.depth_func == DepthFunc::Less;
 
         for block in coverage.blocks() {
             // Depth hierarchy, second level: a block whose every stored depth is in front of the
@@ -381,7 +401,7 @@ impl<S: Shader, P: LaneProgram> LaneKernel for ShadeTriangle<'_, '_, S, P> {
                         // Outside [0, 1] (or NaN): beyond the near or far plane.
                         active = active.and(depth.simd_ge(zero)).and(depth.simd_le(one));
                     }
-                    if state.depth_test {
+                    if depth_test {
                         let stored = match &pending {
                             Some(clear) => clear.depth,
                             None => lanes.load_f32(&rows.depth[at..at + 8]),
@@ -449,7 +469,7 @@ impl<S: Shader, P: LaneProgram> LaneKernel for ShadeTriangle<'_, '_, S, P> {
                             color[1].store_masked(keep, &mut g[at..at + 8]);
                             color[2].store_masked(keep, &mut b[at..at + 8]);
                             color[3].store_masked(keep, &mut a[at..at + 8]);
-                            if state.depth_write {
+                            if depth_write {
                                 depth.store_masked(keep, &mut rows.depth[at..at + 8]);
                             }
                         }
@@ -459,11 +479,7 @@ impl<S: Shader, P: LaneProgram> LaneKernel for ShadeTriangle<'_, '_, S, P> {
                     Some(clear) => {
                         let (color, depth, keep) =
                             written.unwrap_or((clear.color, clear.depth, lanes.mask_all(false)));
-                        let depth = if state.depth_write {
-                            depth
-                        } else {
-                            clear.depth
-                        };
+                        let depth = if depth_write { depth } else { clear.depth };
                         keep.select_f32(color[0], clear.color[0])
                             .store(&mut r[at..at + 8]);
                         keep.select_f32(color[1], clear.color[1])
@@ -480,7 +496,7 @@ impl<S: Shader, P: LaneProgram> LaneKernel for ShadeTriangle<'_, '_, S, P> {
             let shaded_count = shaded_bits.count_ones() as u64;
             counters.shaded += shaded_count;
             counters.discarded += shaded_count - kept_bits.count_ones() as u64;
-            if state.depth_write && kept_bits != 0 {
+            if depth_write && kept_bits != 0 {
                 // Keep the block's bound exact: the largest of its 64 depths.
                 let mut largest = lanes.load_f32(&rows.depth[..8]);
                 for row in 1..8 {
