@@ -1,5 +1,6 @@
 //! Traversal strategies compared on small, large and thin triangles (coverage only: setup is
-//! done once, the benchmark walks every tile the triangles touch and counts covered pixels).
+//! done once, the benchmark walks every tile the triangles touch and counts covered pixels), at
+//! the scalar level and at the best instruction set of this CPU (named `strategy/isa`).
 //!
 //! `cargo bench -p kantele --bench traversal`
 
@@ -8,6 +9,7 @@ use glam::Vec4;
 use kantele::raster::bin::{TileBins, TileGrid};
 use kantele::raster::{rasterize, Strategy};
 use kantele::setup::{setup_triangle, CullMode, FrontFace, TriangleSetup, Viewport};
+use kantele::simd::Isa;
 
 const WIDTH: u32 = 1024;
 const HEIGHT: u32 = 768;
@@ -61,15 +63,23 @@ fn bench_traversal(c: &mut Criterion) {
                     &tris[t.packed() as usize],
                     grid.tile_rect(tile),
                     Strategy::BoundingBox,
+                    Isa::Scalar,
                     |_, _| pixels += 1,
                 );
             }
         }
         let mut group = c.benchmark_group(format!("traversal/{name}"));
         group.throughput(Throughput::Elements(pixels));
-        for strategy in Strategy::ALL {
+        let mut levels = vec![Isa::Scalar];
+        if Isa::best() != Isa::Scalar {
+            levels.push(Isa::best());
+        }
+        let runs = Strategy::ALL
+            .into_iter()
+            .flat_map(|s| levels.iter().map(move |&isa| (s, isa)));
+        for (strategy, isa) in runs {
             group.bench_with_input(
-                BenchmarkId::from_parameter(strategy),
+                BenchmarkId::from_parameter(format!("{strategy}/{isa}")),
                 &strategy,
                 |b, &strategy| {
                     b.iter(|| {
@@ -77,9 +87,13 @@ fn bench_traversal(c: &mut Criterion) {
                         for tile in 0..bins.tile_count() {
                             let rect = grid.tile_rect(tile);
                             for t in bins.tile(tile) {
-                                rasterize(&tris[t.packed() as usize], rect, strategy, |x, _| {
-                                    covered += x as u64 & 1 | 1
-                                });
+                                rasterize(
+                                    &tris[t.packed() as usize],
+                                    rect,
+                                    strategy,
+                                    isa,
+                                    |x, _| covered += x as u64 & 1 | 1,
+                                );
                             }
                         }
                         black_box(covered)

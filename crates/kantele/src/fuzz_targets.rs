@@ -16,6 +16,7 @@ use crate::raster::{rasterize, Strategy};
 use crate::reference::reference_covers;
 use crate::rop::{BlendMode, DepthFunc};
 use crate::setup::{setup_triangle, CullMode, FrontFace, Viewport};
+use crate::simd::Isa;
 use crate::MAX_VARYINGS;
 
 /// Reads the fuzzer's bytes as a stream of numbers; past the end it yields zeros.
@@ -175,16 +176,22 @@ pub fn raster(data: &[u8]) {
         .collect();
     match setup_triangle(&viewport, clip, CullMode::None, FrontFace::Ccw) {
         Ok(tri) => {
-            for strategy in Strategy::ALL {
+            // Every strategy at the best level, and the lane-wide ones at the scalar level too.
+            let runs = Strategy::ALL
+                .into_iter()
+                .map(|s| (s, Isa::best()))
+                .chain([Strategy::Incremental, Strategy::Bisector].map(|s| (s, Isa::Scalar)));
+            for (strategy, isa) in runs {
                 let mut counts = vec![0u32; expected.len()];
-                rasterize(&tri, viewport.rect(), strategy, |x, y| {
+                rasterize(&tri, viewport.rect(), strategy, isa, |x, y| {
                     assert!(
                         (0..width as i32).contains(&x) && (0..height as i32).contains(&y),
                         "{strategy}: pixel ({x}, {y}) outside the {width}×{height} target for {v:?}"
                     );
                     counts[(y as u32 * width + x as u32) as usize] += 1;
                 });
-                compare_coverage(&counts, &expected, width, &v, strategy.name());
+                let name = format!("{strategy} at {isa}");
+                compare_coverage(&counts, &expected, width, &v, &name);
             }
         }
         Err(_) => {

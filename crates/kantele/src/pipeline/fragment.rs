@@ -94,7 +94,7 @@ pub(super) fn raster_tiles(
                         continue;
                     }
                 }
-                rasterize_blocks(tri, rect, strategy, &mut coverage);
+                rasterize_blocks(tri, rect, strategy, isa, &mut coverage);
                 if coverage.is_empty() {
                     continue;
                 }

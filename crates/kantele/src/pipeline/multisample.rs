@@ -67,7 +67,7 @@ pub(super) fn raster_tiles_multisampled(
                         continue;
                     }
                 }
-                rasterize_samples(tri, rect, strategy, samples, &mut coverage);
+                rasterize_samples(tri, rect, strategy, samples, isa, &mut coverage);
                 if coverage.is_empty() {
                     continue;
                 }

@@ -7,12 +7,15 @@
 //! three edges, each once.
 
 pub mod bin;
+mod block_lanes;
 pub mod samples;
 
 use std::str::FromStr;
 
 use crate::fixed::{BLOCK_LOG2, BLOCK_SIZE, TILE_LOG2, TILE_SIZE};
 use crate::setup::{PixelRect, TriangleSetup};
+use crate::simd::{dispatch, Isa, LaneKernel, Lanes};
+use block_lanes::EdgeLanes;
 
 /// How a triangle's pixels are found. Every strategy produces identical coverage.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
@@ -123,12 +126,14 @@ impl BlockCoverage {
 }
 
 /// Finds the covered pixels of `rect` as 8 × 8 block masks, replacing what `out` held. `rect`
-/// must lie within one 64 × 64 tile (tile-aligned), as the pipeline's tiles do.
-#[inline]
+/// must lie within one 64 × 64 tile (tile-aligned), as the pipeline's tiles do. `isa` is the
+/// instruction set of the lane-wide block masks (every level gives the same bits).
+#[inline(never)]
 pub fn rasterize_blocks(
     tri: &TriangleSetup,
     rect: PixelRect,
     strategy: Strategy,
+    isa: Isa,
     out: &mut BlockCoverage,
 ) {
     out.blocks.clear();
@@ -153,23 +158,46 @@ pub fn rasterize_blocks(
         push_rect(rect, out);
         return;
     }
-    match strategy {
-        Strategy::BoundingBox => scan_bounding_box(tri, rect, out),
-        Strategy::Incremental => scan_incremental(tri, rect, out),
-        Strategy::Block => scan_blocks(tri, rect, out),
-        Strategy::Adaptive => {
-            if uses_blocks {
-                scan_blocks(tri, rect, out)
-            } else {
-                scan_incremental(tri, rect, out)
-            }
-        }
-        Strategy::Bisector => {
-            if uses_blocks {
-                scan_bisector(tri, rect, out)
-            } else {
-                scan_incremental(tri, rect, out)
-            }
+    let scan = match strategy {
+        Strategy::BoundingBox => return scan_bounding_box(tri, rect, out),
+        Strategy::Bisector if uses_blocks => Scan::Bisector,
+        Strategy::Block | Strategy::Adaptive if uses_blocks => Scan::Blocks,
+        _ => return scan_incremental(tri, rect, out),
+    };
+    dispatch(
+        isa,
+        ScanKernel {
+            tri,
+            rect,
+            scan,
+            out,
+        },
+    );
+}
+
+/// The scans of 8 × 8 blocks, whose partial blocks' masks are lane-wide.
+#[derive(Clone, Copy)]
+enum Scan {
+    Blocks,
+    Bisector,
+}
+
+/// One scan of one triangle in one tile, compiled per instruction set.
+struct ScanKernel<'a> {
+    tri: &'a TriangleSetup,
+    rect: PixelRect,
+    scan: Scan,
+    out: &'a mut BlockCoverage,
+}
+
+impl LaneKernel for ScanKernel<'_> {
+    type Output = ();
+
+    #[inline(always)]
+    fn run<L: Lanes>(self, lanes: L) {
+        match self.scan {
+            Scan::Blocks => scan_blocks(lanes, self.tri, self.rect, self.out),
+            Scan::Bisector => scan_bisector(lanes, self.tri, self.rect, self.out),
         }
     }
 }
@@ -215,11 +243,12 @@ fn push_rect(rect: PixelRect, out: &mut BlockCoverage) {
 }
 
 /// Calls `visit(x, y)` once for every pixel of `rect` whose centre `tri` covers (any rectangle;
-/// it is walked tile by tile through [`rasterize_blocks`]).
+/// it is walked tile by tile through [`rasterize_blocks`], with the instruction set `isa`).
 pub fn rasterize(
     tri: &TriangleSetup,
     rect: PixelRect,
     strategy: Strategy,
+    isa: Isa,
     mut visit: impl FnMut(i32, i32),
 ) {
     let rect = rect.intersect(&tri.bbox);
@@ -238,7 +267,7 @@ pub fn rasterize(
                 x1: tx + tile,
                 y1: ty + tile,
             });
-            rasterize_blocks(tri, part, strategy, &mut coverage);
+            rasterize_blocks(tri, part, strategy, isa, &mut coverage);
             for block in coverage.blocks() {
                 let mut bits = block.mask;
                 while bits != 0 {
@@ -439,7 +468,9 @@ impl EdgeStepper {
 }
 
 /// Bounding-box scan with incremental edge functions: each row's values stepped by one add per
-/// edge from the row above ([`EdgeStepper::row_bits`] within the row).
+/// edge from the row above ([`EdgeStepper::row_bits`] within the row). (Lane-wide block masks
+/// were measured here too: for the few rows of a small triangle their set-up costs more than
+/// the rows, 0–4% more instructions on the mesh scenes.)
 fn scan_incremental(tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverage) {
     let stepper = EdgeStepper::at(tri, rect.x0, rect.y0);
     let mut row = stepper.value;
@@ -452,7 +483,7 @@ fn scan_incremental(tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverag
     });
 }
 
-/// How a block relates to the triangle, judged by the edge values at its corner pixels.
+/// How an 8 × 8 block relates to the triangle, judged by the edge values at its corner pixels.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum BlockClass {
     /// Every corner is outside one edge: no pixel is covered.
@@ -464,10 +495,22 @@ enum BlockClass {
 }
 
 /// The block grid of the strategies that use 8 × 8 blocks: blocks are aligned to multiples of
-/// 8 pixels and clipped to the rectangle being drawn.
+/// 8 pixels, classified whole, and their coverage clipped to the rectangle being drawn.
+///
+/// Classifying the whole aligned block rather than its part inside the rectangle costs one
+/// pair of additions per edge (the extreme corners' offsets are the same for every block) and
+/// changes no bit: a whole block that is empty or full is so inside the rectangle too, and a
+/// partial one is tested pixel by pixel. At the rectangle's border a block empty inside it may
+/// be called partial, which only lets the bisector's walk go one block further (the blocks not
+/// rejected by an edge still form one run per row).
 struct BlockGrid {
     rect: PixelRect,
     stepper: EdgeStepper,
+    /// Per edge, the offsets from a block's first pixel to its smallest and largest value
+    /// (a linear function's extremes over a rectangle lie at the corners its steps' signs
+    /// pick).
+    lowest: [i64; 3],
+    highest: [i64; 3],
     /// First and one-past-last block column / row (in block units).
     bx0: i32,
     bx1: i32,
@@ -477,9 +520,19 @@ struct BlockGrid {
 
 impl BlockGrid {
     fn new(tri: &TriangleSetup, rect: PixelRect) -> Self {
+        let stepper = EdgeStepper::at(tri, rect.x0, rect.y0);
+        let last = (BLOCK_SIZE - 1) as i64;
+        let (mut lowest, mut highest) = ([0; 3], [0; 3]);
+        for e in 0..3 {
+            let (sx, sy) = (stepper.step_x[e], stepper.step_y[e]);
+            lowest[e] = (sx.min(0) + sy.min(0)) * last;
+            highest[e] = (sx.max(0) + sy.max(0)) * last;
+        }
         Self {
             rect,
-            stepper: EdgeStepper::at(tri, rect.x0, rect.y0),
+            stepper,
+            lowest,
+            highest,
             bx0: rect.x0 >> BLOCK_LOG2,
             bx1: ((rect.x1 - 1) >> BLOCK_LOG2) + 1,
             by0: rect.y0 >> BLOCK_LOG2,
@@ -509,76 +562,109 @@ impl BlockGrid {
         )
     }
 
-    /// Classifies the (clipped) block by its four corner pixels; also returns which edge
-    /// rejected it, for the bisector's search direction.
-    #[inline]
-    fn classify(&self, block: &PixelRect) -> (BlockClass, Option<usize>) {
-        let corners = [
-            self.values_at(block.x0, block.y0),
-            self.values_at(block.x1 - 1, block.y0),
-            self.values_at(block.x0, block.y1 - 1),
-            self.values_at(block.x1 - 1, block.y1 - 1),
-        ];
-        let mut all_inside = true;
-        for edge in 0..3 {
-            let inside_count = corners.iter().filter(|c| c[edge] >= 0).count();
-            if inside_count == 0 {
-                return (BlockClass::Empty, Some(edge));
+    /// Classifies the whole block whose first pixel has the edge values `origin`, and returns,
+    /// with the class, the edge that rejected an empty block (for the bisector's search
+    /// direction) and which edges cross a partial one.
+    #[inline(always)]
+    fn classify(&self, origin: [i64; 3]) -> (BlockClass, Option<usize>, [bool; 3]) {
+        let mut crossing = [false; 3];
+        for (edge, crosses) in crossing.iter_mut().enumerate() {
+            if origin[edge] + self.highest[edge] < 0 {
+                return (BlockClass::Empty, Some(edge), crossing);
             }
-            all_inside &= inside_count == 4;
+            *crosses = origin[edge] + self.lowest[edge] < 0;
         }
-        if all_inside {
-            (BlockClass::Full, None)
+        let class = if crossing.contains(&true) {
+            BlockClass::Partial
         } else {
-            (BlockClass::Partial, None)
+            BlockClass::Full
+        };
+        (class, None, crossing)
+    }
+
+    /// Coverage bits of a partial block whose first pixel has the edge values `origin`, within
+    /// `part` (its pixels inside the rectangle), the edges other than `crossing` holding the
+    /// whole block: the lane-wide rows of [`EdgeLanes`] when the block's values fit in 32 bits,
+    /// else [`BlockGrid::rows_mask`].
+    #[inline(always)]
+    fn partial_mask<L: Lanes>(
+        &self,
+        lanes: L,
+        origin: [i64; 3],
+        crossing: [bool; 3],
+        part: &PixelRect,
+    ) -> u64 {
+        // An edge that holds the whole block is left out: its values may be large, and it
+        // changes no bit.
+        let keep =
+            |values: [i64; 3]| std::array::from_fn(|e| if crossing[e] { values[e] } else { 0 });
+        match EdgeLanes::new(
+            lanes,
+            keep(origin),
+            keep(self.stepper.step_x),
+            keep(self.stepper.step_y),
+        ) {
+            Some(edges) => {
+                let rows = (part.y0 & 7)..((part.y1 - 1) & 7) + 1;
+                edges.mask(lanes, rows) & rect_mask(part)
+            }
+            None => self.rows_mask(part),
         }
     }
 
-    /// Coverage bits of a block of the given class (bit `8·r + c` = pixel `(x + c, y + r)`
-    /// relative to the block's 8-aligned origin).
-    #[inline]
-    fn block_mask(&self, block: &PixelRect, class: BlockClass) -> u64 {
-        let shift = |x: i32, y: i32| ((y & 7) << 3) | (x & 7);
-        match class {
-            BlockClass::Empty => 0,
-            BlockClass::Full => {
-                let row = (u64::MAX >> (64 - block.width())) << (block.x0 & 7);
-                let mut mask = 0;
-                for y in block.y0..block.y1 {
-                    mask |= row << ((y & 7) << 3);
-                }
-                mask
-            }
-            BlockClass::Partial => {
-                let mut row = self.values_at(block.x0, block.y0);
-                let mut mask = 0;
-                for y in block.y0..block.y1 {
-                    mask |= self.stepper.row_bits(row, block.x0, block.x1) << shift(block.x0, y);
-                    row[0] += self.stepper.step_y[0];
-                    row[1] += self.stepper.step_y[1];
-                    row[2] += self.stepper.step_y[2];
-                }
-                mask
-            }
+    /// The coverage bits of `part` (the pixels of one block) by 64-bit values, a row at a
+    /// time ([`EdgeStepper::row_bits`]).
+    #[inline(never)]
+    fn rows_mask(&self, part: &PixelRect) -> u64 {
+        let mut row = self.values_at(part.x0, part.y0);
+        let mut mask = 0;
+        for y in part.y0..part.y1 {
+            let shift = ((y & 7) << 3) | (part.x0 & 7);
+            mask |= self.stepper.row_bits(row, part.x0, part.x1) << shift;
+            row[0] += self.stepper.step_y[0];
+            row[1] += self.stepper.step_y[1];
+            row[2] += self.stepper.step_y[2];
         }
+        mask
     }
 
     /// Classifies one block and appends its coverage; returns its class and rejecting edge.
-    #[inline]
-    fn process(&self, bx: i32, by: i32, out: &mut BlockCoverage) -> (BlockClass, Option<usize>) {
-        let block = self.block_rect(bx, by);
-        let (class, edge) = self.classify(&block);
-        out.push(block.x0, block.y0, self.block_mask(&block, class));
+    #[inline(always)]
+    fn process<L: Lanes>(
+        &self,
+        lanes: L,
+        bx: i32,
+        by: i32,
+        out: &mut BlockCoverage,
+    ) -> (BlockClass, Option<usize>) {
+        let origin = self.values_at(bx << BLOCK_LOG2, by << BLOCK_LOG2);
+        let (class, edge, crossing) = self.classify(origin);
+        let part = self.block_rect(bx, by);
+        let mask = match class {
+            BlockClass::Empty => 0,
+            BlockClass::Full => rect_mask(&part),
+            BlockClass::Partial => self.partial_mask(lanes, origin, crossing, &part),
+        };
+        out.push(part.x0, part.y0, mask);
         (class, edge)
     }
 }
 
+/// The bits of `part` (non-empty, within one 8-aligned block) in that block's mask.
+#[inline(always)]
+fn rect_mask(part: &PixelRect) -> u64 {
+    let columns = (0xffu64 >> (BLOCK_SIZE as i32 - part.width())) << (part.x0 & 7);
+    let rows = (u64::MAX >> (64 - 8 * part.height())) << ((part.y0 & 7) << 3);
+    (columns * 0x0101_0101_0101_0101) & rows
+}
+
 /// Row-by-row block traversal of the whole box (the paper's block-based model).
-fn scan_blocks(tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverage) {
+#[inline(always)]
+fn scan_blocks<L: Lanes>(lanes: L, tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverage) {
     let grid = BlockGrid::new(tri, rect);
     for by in grid.by0..grid.by1 {
         for bx in grid.bx0..grid.bx1 {
-            grid.process(bx, by, out);
+            grid.process(lanes, bx, by, out);
         }
     }
 }
@@ -590,7 +676,13 @@ fn scan_blocks(tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverage) {
 /// start is halfway between the previous row's bounds (the topmost vertex's block on the first
 /// row); when the start itself is empty, the edge that rejected it says on which side the run
 /// lies.
-fn scan_bisector(tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverage) {
+#[inline(always)]
+fn scan_bisector<L: Lanes>(
+    lanes: L,
+    tri: &TriangleSetup,
+    rect: PixelRect,
+    out: &mut BlockCoverage,
+) {
     let grid = BlockGrid::new(tri, rect);
     let top = tri
         .pos_subpixel
@@ -604,7 +696,7 @@ fn scan_bisector(tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverage) 
         let mut found = None;
         let mut direction = 0i32;
         while (grid.bx0..grid.bx1).contains(&bx) {
-            let (class, edge) = grid.process(bx, by, out);
+            let (class, edge) = grid.process(lanes, bx, by, out);
             if class != BlockClass::Empty {
                 found = Some(bx);
                 break;
@@ -621,11 +713,11 @@ fn scan_bisector(tri: &TriangleSetup, rect: PixelRect, out: &mut BlockCoverage) 
         }
         let Some(seed) = found else { continue };
         let mut right = seed + 1;
-        while right < grid.bx1 && grid.process(right, by, out).0 != BlockClass::Empty {
+        while right < grid.bx1 && grid.process(lanes, right, by, out).0 != BlockClass::Empty {
             right += 1;
         }
         let mut left = seed - 1;
-        while left >= grid.bx0 && grid.process(left, by, out).0 != BlockClass::Empty {
+        while left >= grid.bx0 && grid.process(lanes, left, by, out).0 != BlockClass::Empty {
             left -= 1;
         }
         // Next row starts halfway between this row's bounds.
@@ -639,9 +731,14 @@ mod tests {
     use crate::setup::{setup_triangle, CullMode, FrontFace, Viewport};
     use glam::Vec4;
 
-    fn coverage(tri: &TriangleSetup, rect: PixelRect, strategy: Strategy) -> Vec<(i32, i32)> {
+    fn coverage(
+        tri: &TriangleSetup,
+        rect: PixelRect,
+        strategy: Strategy,
+        isa: Isa,
+    ) -> Vec<(i32, i32)> {
         let mut out = Vec::new();
-        rasterize(tri, rect, strategy, |x, y| out.push((x, y)));
+        rasterize(tri, rect, strategy, isa, |x, y| out.push((x, y)));
         out.sort_unstable();
         out
     }
@@ -690,6 +787,14 @@ mod tests {
         }
     }
 
+    fn supported_isas() -> Vec<Isa> {
+        Isa::ALL.into_iter().filter(|i| i.is_supported()).collect()
+    }
+
+    /// Every strategy at every supported instruction-set level finds the pixels of the
+    /// bounding-box scan (each pixel tested from scratch), for triangles within the target and,
+    /// one in four, reaching far into the guard band (edge values beyond 32 bits within a
+    /// block, where the lane-wide masks give way to the 64-bit rows).
     #[test]
     fn all_strategies_agree_on_many_triangles() {
         let vp = Viewport::new(200, 150);
@@ -700,10 +805,13 @@ mod tests {
             seed ^= seed << 17;
             (seed % 10_000) as f32 / 10_000.0 * 2.6 - 1.3
         };
+        let isas = supported_isas();
         let mut checked = 0;
-        for _ in 0..400 {
+        for case in 0..400 {
+            // NDC ±1.3, or ±130 (about ±13 000 pixels) for one vertex in four triangles.
+            let far = if case % 4 == 3 { 100.0 } else { 1.0 };
             let p = [
-                Vec4::new(rand(), rand(), 0.0, 1.0),
+                Vec4::new(rand() * far, rand() * far, 0.0, 1.0),
                 Vec4::new(rand(), rand(), 0.0, 1.0),
                 Vec4::new(rand(), rand(), 0.0, 1.0),
             ];
@@ -719,9 +827,15 @@ mod tests {
                         x1: (tx * 64 + 64).min(200),
                         y1: (ty * 64 + 64).min(150),
                     };
-                    let reference = coverage(&tri, rect, Strategy::BoundingBox);
+                    let reference = coverage(&tri, rect, Strategy::BoundingBox, Isa::Scalar);
                     for s in Strategy::ALL {
-                        assert_eq!(coverage(&tri, rect, s), reference, "{s} differs");
+                        for &isa in &isas {
+                            assert_eq!(
+                                coverage(&tri, rect, s, isa),
+                                reference,
+                                "{s} at {isa} differs"
+                            );
+                        }
                     }
                 }
             }
@@ -770,10 +884,16 @@ mod tests {
                 .flat_map(|x| (rect.y0..rect.y1).map(move |y| (x, y)))
                 .collect();
             for s in Strategy::ALL {
-                assert_eq!(coverage(&tri, rect, s), expected, "{s} on {rect:?}");
+                for isa in supported_isas() {
+                    assert_eq!(
+                        coverage(&tri, rect, s, isa),
+                        expected,
+                        "{s} {isa} on {rect:?}"
+                    );
+                }
             }
             let mut blocks = BlockCoverage::default();
-            rasterize_blocks(&tri, rect, Strategy::Bisector, &mut blocks);
+            rasterize_blocks(&tri, rect, Strategy::Bisector, Isa::best(), &mut blocks);
             assert_eq!(blocks.pixel_count(), expected.len() as u64);
         }
     }

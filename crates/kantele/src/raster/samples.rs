@@ -12,6 +12,7 @@ use super::{rasterize_blocks, BlockCoverage, Strategy};
 use crate::fixed::{BLOCK_LOG2, TILE_SIZE};
 use crate::multisample::{SampleCount, MAX_SAMPLES};
 use crate::setup::{PixelRect, TriangleSetup};
+use crate::simd::Isa;
 
 /// 8 × 8 blocks per tile.
 const BLOCKS: usize = ((TILE_SIZE >> BLOCK_LOG2) * (TILE_SIZE >> BLOCK_LOG2)) as usize;
@@ -128,6 +129,7 @@ pub fn rasterize_samples(
     rect: PixelRect,
     strategy: Strategy,
     samples: SampleCount,
+    isa: Isa,
     out: &mut SampleCoverage,
 ) {
     out.clear();
@@ -146,7 +148,7 @@ pub fn rasterize_samples(
             }
             t
         };
-        rasterize_blocks(&shifted, rect, strategy, &mut out.scratch);
+        rasterize_blocks(&shifted, rect, strategy, isa, &mut out.scratch);
         for block in out.scratch.blocks() {
             let index = crate::rop::TileBuffer::block_index(block.x, block.y);
             if out.union[index] == 0 {
@@ -207,8 +209,12 @@ mod tests {
                         x1: (tx + 64).min(100),
                         y1: (ty + 64).min(70),
                     };
-                    for strategy in Strategy::ALL {
-                        rasterize_samples(&tri, rect, strategy, samples, &mut coverage);
+                    let levels = [Isa::Scalar, Isa::best()];
+                    for (strategy, isa) in Strategy::ALL
+                        .into_iter()
+                        .flat_map(|s| levels.map(|isa| (s, isa)))
+                    {
+                        rasterize_samples(&tri, rect, strategy, samples, isa, &mut coverage);
                         let mut found = [0u64; MAX_COVERAGE_PLANES];
                         let mut planes = vec![[0u64; 64]; coverage.planes()];
                         for b in coverage.blocks() {
@@ -226,7 +232,7 @@ mod tests {
                                     assert_eq!(
                                         plane[block] >> bit & 1 == 1,
                                         covered(&tri, x, y, offset),
-                                        "{strategy} plane {p} pixel ({x}, {y})"
+                                        "{strategy} {isa} plane {p} pixel ({x}, {y})"
                                     );
                                 }
                             }
@@ -270,6 +276,7 @@ mod tests {
             rect,
             Strategy::Bisector,
             SampleCount::X4,
+            Isa::best(),
             &mut coverage,
         );
         assert!(coverage.sample_count() > 0);
