@@ -64,7 +64,7 @@ fn triangles(count: usize, legs: f32) -> Vec<(Vec2, Vec4)> {
 }
 
 fn bench_fill(c: &mut Criterion) {
-    let isas: Vec<Isa> = Isa::ALL.into_iter().filter(|i| i.is_supported()).collect();
+    let isas: Vec<Isa> = Isa::supported().collect();
     for (legs, count) in [(2.0, 40_000), (8.0, 20_000), (32.0, 4_000), (128.0, 400)] {
         let vertices = triangles(count, legs);
         let pixels = (count as f64 * legs as f64 * legs as f64 / 2.0) as u64;

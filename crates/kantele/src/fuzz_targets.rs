@@ -180,7 +180,7 @@ pub fn raster(data: &[u8]) {
             let runs = Strategy::ALL
                 .into_iter()
                 .map(|s| (s, Isa::best()))
-                .chain([Strategy::Incremental, Strategy::Bisector].map(|s| (s, Isa::Scalar)));
+                .chain([Strategy::Block, Strategy::Bisector].map(|s| (s, Isa::Scalar)));
             for (strategy, isa) in runs {
                 let mut counts = vec![0u32; expected.len()];
                 rasterize(&tri, viewport.rect(), strategy, isa, |x, y| {

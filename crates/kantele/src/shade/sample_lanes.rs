@@ -599,10 +599,6 @@ mod tests {
         Texture::from_rgba8(width, height, &rgba, color_space).expect("texture")
     }
 
-    fn supported_isas() -> Vec<Isa> {
-        Isa::ALL.into_iter().filter(|i| i.is_supported()).collect()
-    }
-
     const WRAPS: [Wrap; 3] = [Wrap::Repeat, Wrap::ClampToEdge, Wrap::MirroredRepeat];
     const MIN_FILTERS: [MinFilter; 6] = [
         MinFilter::Nearest,
@@ -667,7 +663,7 @@ mod tests {
     #[test]
     fn log2_polynomial_is_close_to_libm() {
         let mut rng = Rng(99);
-        let isas = supported_isas();
+        let isas: Vec<Isa> = Isa::supported().collect();
         for _ in 0..2000 {
             let x: [f32; 8] = std::array::from_fn(|_| 2f32.powf(rng.range(-126.0, 127.0)));
             let reference = dispatch(Isa::Scalar, Log2(x));
@@ -718,7 +714,7 @@ mod tests {
     #[test]
     fn lanes_agree_with_the_scalar_sampler_for_every_wrap_and_filter() {
         let mut rng = Rng(7);
-        let isas = supported_isas();
+        let isas: Vec<Isa> = Isa::supported().collect();
         for (texture, tolerance) in [
             (noise_texture(16, 8, ColorSpace::Srgb), 2e-5),
             (noise_texture(5, 3, ColorSpace::Linear), 2e-5),
@@ -769,7 +765,7 @@ mod tests {
     #[test]
     fn decoded_copy_and_bytes_sample_alike() {
         let mut rng = Rng(11);
-        let isas = supported_isas();
+        let isas: Vec<Isa> = Isa::supported().collect();
         for texture in [
             noise_texture(16, 8, ColorSpace::Srgb),
             noise_texture(7, 5, ColorSpace::Srgb),
@@ -842,7 +838,7 @@ mod tests {
             active: 0xff,
         };
         for sampler in samplers() {
-            for isa in supported_isas() {
+            for isa in Isa::supported() {
                 let got = dispatch(
                     isa,
                     Sample {

@@ -174,6 +174,11 @@ impl Isa {
         }
     }
 
+    /// Every level this CPU supports, in declaration order (always [`Isa::Scalar`] first).
+    pub fn supported() -> impl Iterator<Item = Isa> {
+        Isa::ALL.into_iter().filter(|isa| isa.is_supported())
+    }
+
     /// The best level this CPU supports: AVX-512, then AVX2, SSE4.1 and SSE2 on x86-64; NEON
     /// on AArch64; [`Isa::Scalar`] elsewhere.
     pub fn best() -> Isa {
