@@ -45,7 +45,7 @@ impl TexelSource<'_> {
     }
 
     /// The texels at `index` and `index + 1` (one 8-byte read per lane and texel of bytes, one
-    /// 16-byte read in two halves of a decoded copy), unpacked. `index + 1` must lie in the
+    /// 16-byte read per lane of a decoded copy), unpacked. `index + 1` must lie in the
     /// texture's storage for live lanes.
     #[inline(always)]
     pub(super) fn fetch_pair<L: Lanes>(self, index: L::I32) -> (Channels<L>, Channels<L>) {
@@ -58,9 +58,7 @@ impl TexelSource<'_> {
                 )
             }
             TexelSource::Linear16(words) => {
-                let word = index + index;
-                let (rg0, ba0) = word.gather_u32_pair(words);
-                let (rg1, ba1) = (word + word.lanes().splat_i32(2)).gather_u32_pair(words);
+                let [rg0, ba0, rg1, ba1] = (index + index).gather_u32_quad(words);
                 (unpack_words::<L>(rg0, ba0), unpack_words::<L>(rg1, ba1))
             }
         }

@@ -527,6 +527,43 @@ impl super::TexelGather for Avx2I32 {
     }
 
     #[inline(always)]
+    fn gather_u32_quad(self, table: &[u32]) -> [Self; 4] {
+        let Some(last) = table.len().checked_sub(4) else {
+            return avx!([Avx2I32(_mm256_setzero_si256()); 4]);
+        };
+        let last = i32::try_from(last).unwrap_or(i32::MAX);
+        avx!({
+            let index = _mm256_min_epi32(
+                _mm256_max_epi32(self.0, _mm256_setzero_si256()),
+                _mm256_set1_epi32(last),
+            );
+            let mut at = [0i32; 8];
+            _mm256_storeu_si256(at.as_mut_ptr().cast(), index);
+            // Every clamped index is in `0..=table.len() - 4`, so every 16-byte read (entries
+            // `c..c + 4`) is inside `table`; `c ≥ 0`, so the `usize` conversion is exact.
+            let row = |k: usize| -> __m128i {
+                _mm_loadu_si128(table.as_ptr().add(at[k] as usize).cast())
+            };
+            // Lane `k` in the low half and lane `k + 4` in the high half: [w0 w1 w2 w3] each.
+            let r0 = _mm256_inserti128_si256::<1>(_mm256_castsi128_si256(row(0)), row(4));
+            let r1 = _mm256_inserti128_si256::<1>(_mm256_castsi128_si256(row(1)), row(5));
+            let r2 = _mm256_inserti128_si256::<1>(_mm256_castsi128_si256(row(2)), row(6));
+            let r3 = _mm256_inserti128_si256::<1>(_mm256_castsi128_si256(row(3)), row(7));
+            // A 4 × 4 transpose in each half: word `i` of lanes 0–3 (low) and 4–7 (high).
+            let t0 = _mm256_unpacklo_epi32(r0, r1);
+            let t1 = _mm256_unpacklo_epi32(r2, r3);
+            let t2 = _mm256_unpackhi_epi32(r0, r1);
+            let t3 = _mm256_unpackhi_epi32(r2, r3);
+            [
+                Avx2I32(_mm256_unpacklo_epi64(t0, t1)),
+                Avx2I32(_mm256_unpackhi_epi64(t0, t1)),
+                Avx2I32(_mm256_unpacklo_epi64(t2, t3)),
+                Avx2I32(_mm256_unpackhi_epi64(t2, t3)),
+            ]
+        })
+    }
+
+    #[inline(always)]
     fn lookup_rgb(self, table: &[u32; 256]) -> [Self; 3] {
         let byte = avx!(_mm256_set1_epi32(0xff));
         let base: *const i32 = table.as_ptr().cast();

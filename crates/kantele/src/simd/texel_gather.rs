@@ -5,8 +5,8 @@
 //! [`TexelGather`] is a separate trait (every [`Lanes::I32`](super::Lanes::I32) implements it)
 //! so the sampler's operations stay in one block. The readable reference is written on arrays
 //! with scalar loads; the scalar, SSE2/SSE4.1 and NEON implementations use it as it is (SSE and
-//! NEON have no gather instruction). AVX2 fetches pairs with two `vpgatherdq` and decodes with
-//! three `vpgatherdd` (in `avx2.rs`, the block marked `TexelGather`). Every implementation
+//! NEON have no gather instruction). AVX2 fetches pairs with two `vpgatherdq`, runs of four
+//! entries with one 16-byte load per lane and a transpose, and decodes with three `vpgatherdd` (in `avx2.rs`, the block marked `TexelGather`). Every implementation
 //! returns the same bits for every input: they are table reads.
 
 use super::{I32x8, Lanes};
@@ -18,6 +18,12 @@ pub trait TexelGather: I32x8 {
     /// `table` has fewer than two entries. One read of 8 bytes per lane on AVX2 (`vpgatherdq`):
     /// the two texels of a bilinear footprint's row, when they are neighbours in memory.
     fn gather_u32_pair(self, table: &[u32]) -> (Self, Self);
+
+    /// Four neighbouring table entries per lane: lane `k` of result `i` is `table[c + i]`, with
+    /// `c = clamp(self[k], 0, table.len() - 4)`; all zeros when `table` has fewer than four
+    /// entries. One 16-byte load per lane and a transpose on AVX2: the two texels of a bilinear
+    /// footprint's row in a texture's decoded copy (two words a texel).
+    fn gather_u32_quad(self, table: &[u32]) -> [Self; 4];
 
     /// Bytes 0, 1 and 2 of each lane (red, green and blue of a packed texel) decoded through a
     /// 256-entry table: lane `k` of result `c` is `table[(self[k] >> 8c) & 0xff]`.
@@ -38,6 +44,22 @@ fn gather_pair_reference(index: [i32; 8], table: &[u32]) -> ([i32; 8], [i32; 8])
         second[k] = table[c + 1] as i32;
     }
     (first, second)
+}
+
+/// [`TexelGather::gather_u32_quad`] on plain arrays: the reference.
+#[inline(always)]
+fn gather_quad_reference(index: [i32; 8], table: &[u32]) -> [[i32; 8]; 4] {
+    let mut out = [[0i32; 8]; 4];
+    let Some(last) = table.len().checked_sub(4) else {
+        return out;
+    };
+    for k in 0..8 {
+        let c = usize::try_from(index[k]).unwrap_or(0).min(last);
+        for (i, entries) in out.iter_mut().enumerate() {
+            entries[k] = table[c + i] as i32;
+        }
+    }
+    out
 }
 
 /// [`TexelGather::lookup_rgb`] on plain arrays: the reference.
@@ -63,6 +85,18 @@ macro_rules! texel_gather_by_reference {
                 let lanes = self.lanes();
                 let (first, second) = gather_pair_reference(self.to_array(), table);
                 (lanes.i32_from_array(first), lanes.i32_from_array(second))
+            }
+
+            #[inline(always)]
+            fn gather_u32_quad(self, table: &[u32]) -> [Self; 4] {
+                let lanes = self.lanes();
+                let [a, b, c, d] = gather_quad_reference(self.to_array(), table);
+                [
+                    lanes.i32_from_array(a),
+                    lanes.i32_from_array(b),
+                    lanes.i32_from_array(c),
+                    lanes.i32_from_array(d),
+                ]
             }
 
             #[inline(always)]
@@ -108,6 +142,20 @@ mod tests {
         }
     }
 
+    struct Quad<'a> {
+        index: [i32; 8],
+        table: &'a [u32],
+    }
+
+    impl LaneKernel for Quad<'_> {
+        type Output = [[i32; 8]; 4];
+        #[inline(always)]
+        fn run<L: Lanes>(self, lanes: L) -> Self::Output {
+            let [a, b, c, d] = lanes.i32_from_array(self.index).gather_u32_quad(self.table);
+            [a.to_array(), b.to_array(), c.to_array(), d.to_array()]
+        }
+    }
+
     struct Bytes<'a> {
         packed: [i32; 8],
         table: &'a [u32; 256],
@@ -148,6 +196,35 @@ mod tests {
                     let got = dispatch(
                         isa,
                         Pair {
+                            index,
+                            table: &table,
+                        },
+                    );
+                    assert_eq!(got, expected, "{isa}, {len} entries, {index:?}");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn quads_are_four_neighbouring_entries_with_clamped_indices() {
+        let edges = [i32::MIN, -1, 0, 1, 3, 4, 5, 6, 7, 8, 1000, i32::MAX];
+        for len in [0usize, 1, 3, 4, 5, 8, 9, 17] {
+            let table: Vec<u32> = (0..len as u32)
+                .map(|i| 0x8000_0001u32.wrapping_mul(i + 1))
+                .collect();
+            for start in 0..edges.len() {
+                let index: [i32; 8] = std::array::from_fn(|k| edges[(start + k) % edges.len()]);
+                let expected: [[i32; 8]; 4] = if len < 4 {
+                    [[0; 8]; 4]
+                } else {
+                    let c = |k: usize| (index[k].max(0) as usize).min(len - 4);
+                    std::array::from_fn(|i| std::array::from_fn(|k| table[c(k) + i] as i32))
+                };
+                for isa in isas() {
+                    let got = dispatch(
+                        isa,
+                        Quad {
                             index,
                             table: &table,
                         },
