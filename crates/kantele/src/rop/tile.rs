@@ -442,6 +442,19 @@ impl TileBuffer {
             Some(clear) => Some(clear),
             None => None,
         };
+        let side = TILE_SIZE as i32;
+        if tile.width() == side && tile.height() == side {
+            // A tile wholly on the target (most of them): every block is whole, so the bound is
+            // the largest of the 64 kept block maxima (a pending block's is its clear depth),
+            // taken eight at a time so that the compiler keeps it in vector registers.
+            let mut lanes = [f32::NEG_INFINITY; 8];
+            for eight in self.block_depth_max.chunks_exact(8) {
+                for (lane, &value) in lanes.iter_mut().zip(eight) {
+                    *lane = lane.max(value);
+                }
+            }
+            return lanes.into_iter().fold(f32::NEG_INFINITY, f32::max);
+        }
         let block = BLOCK_SIZE as i32;
         let mut bound = f32::NEG_INFINITY;
         for by in 0..(TILE_SIZE as i32 / block) {
@@ -532,4 +545,45 @@ fn filled_vec<T: Clone>(n: usize, value: T) -> Result<Vec<T>, RenderError> {
         })?;
     v.resize(n, value);
     Ok(v)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bound of a tile wholly on the target (the 64 kept block maxima) and of a tile cut by
+    /// the target's edge (blocks read pixel by pixel there) both follow the depths written.
+    #[test]
+    fn exact_depth_bound_follows_block_maxima_and_pixels() {
+        let full = PixelRect {
+            x0: 0,
+            y0: 0,
+            x1: TILE_SIZE as i32,
+            y1: TILE_SIZE as i32,
+        };
+        let cut = PixelRect { y1: 60, ..full };
+        let mut tile = TileBuffer::new(SampleCount::X1).expect("tile");
+        tile.fill(Some(Vec4::ZERO), Some(0.5));
+        assert_eq!(tile.exact_depth_bound(&full), 0.5);
+        // Block 9 written with depths up to 0.75; the rest still pending at 0.5.
+        let _ = tile.take_pending_block(9);
+        let first = block_first_pixel(9);
+        fill_block(&mut tile.depth, first, 0.25);
+        tile.depth[first + 3] = 0.75;
+        tile.set_block_depth_max(9, 0.75);
+        assert_eq!(tile.exact_depth_bound(&full), 0.75);
+        assert_eq!(tile.exact_depth_bound(&cut), 0.75);
+        // The last block row lies partly past the target's edge (rows 56–59 of 64): there only
+        // the pixels on the target count, whatever the block's kept maximum says.
+        let last = BLOCKS_PER_TILE - 1;
+        let _ = tile.take_pending_block(last);
+        let first = block_first_pixel(last);
+        fill_block(&mut tile.depth, first, 0.125);
+        tile.depth[first + 6 * TILE_SIZE as usize] = 0.875;
+        tile.set_block_depth_max(last, 0.875);
+        assert_eq!(tile.exact_depth_bound(&full), 0.875);
+        assert_eq!(tile.exact_depth_bound(&cut), 0.75);
+        tile.set_block_depth_max(17, 0.9375);
+        assert_eq!(tile.exact_depth_bound(&full), 0.9375);
+    }
 }
