@@ -164,7 +164,7 @@ fn every_strategy_and_thread_count_renders_the_same_image() {
         covered > 10_000,
         "scene should cover much of the target ({covered})"
     );
-    let isas: Vec<Isa> = Isa::ALL.into_iter().filter(|i| i.is_supported()).collect();
+    let isas: Vec<Isa> = Isa::supported().collect();
     assert!(
         isas.len() > 1 || cfg!(not(target_arch = "x86_64")),
         "{isas:?}"
