@@ -125,7 +125,7 @@ impl<S: Shader> DrawCall<'_, S> {
                 for v in order {
                     out.attrs.extend_from_slice(varyings[v]);
                 }
-                out.triangles.push(tri);
+                out.push(tri);
             }
             Err(SetupReject::Culled) => out.counters.culled += 1,
             Err(SetupReject::Degenerate) => out.counters.degenerate += 1,

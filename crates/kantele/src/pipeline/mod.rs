@@ -43,7 +43,7 @@ use crate::multisample::SampleCount;
 use crate::raster::bin::TileBins;
 use crate::raster::Strategy;
 use crate::rop::Framebuffer;
-use crate::setup::{TriangleSetup, Viewport};
+use crate::setup::{PixelRect, Viewport};
 use crate::simd::Isa;
 use crate::stats::{FrameStats, FrameStop};
 use crate::{MAX_TARGET_SIZE, MAX_VARYINGS};
@@ -361,7 +361,7 @@ impl<'a> Frame<'_, 'a> {
 
             let binning_start = Instant::now();
             let grid = *framebuffer.grid();
-            let batches: Vec<&[TriangleSetup]> = geometry.triangle_batches().collect();
+            let batches: Vec<&[PixelRect]> = geometry.bbox_batches().collect();
             stats.bin_entries = bins.bin_batches(&grid, &batches);
             stats.triangles_binned = batches.iter().map(|b| b.len() as u64).sum();
             stats.binning_time = binning_start.elapsed();

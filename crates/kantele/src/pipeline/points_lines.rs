@@ -153,7 +153,7 @@ fn emit_quad(
                 for k in order {
                     out.attrs.extend_from_slice(&end(k).2[..n]);
                 }
-                out.triangles.push(tri);
+                out.push(tri);
             }
             Err(SetupReject::Culled) | Err(SetupReject::Degenerate) => out.counters.degenerate += 1,
         }

@@ -126,17 +126,18 @@ impl TileBins {
     /// Bins one slice of triangles (references are their indices in the slice); returns the
     /// number of bin entries written. See [`TileBins::bin_batches`].
     pub fn bin_triangles(&mut self, grid: &TileGrid, triangles: &[TriangleSetup]) -> u64 {
-        let batches: Vec<&[TriangleSetup]> =
-            triangles.chunks(TriangleRef::MAX_BATCH_TRIANGLES).collect();
+        let boxes: Vec<PixelRect> = triangles.iter().map(|t| t.bbox).collect();
+        let batches: Vec<&[PixelRect]> = boxes.chunks(TriangleRef::MAX_BATCH_TRIANGLES).collect();
         self.bin_batches(grid, &batches)
     }
 
-    /// Appends every triangle of `batches` (in order) to the bins its bounding box touches;
-    /// returns the number of bin entries written. A triangle whose box touches a tile but covers
-    /// none of its pixels is still binned there; traversal finds no pixel. Each batch holds at
-    /// most [`TriangleRef::MAX_BATCH_TRIANGLES`] triangles, and there are at most
+    /// Appends every triangle of `batches` (in order; each given by its pixel box,
+    /// [`TriangleSetup::bbox`]) to the bins its box touches; returns the number of bin entries
+    /// written. A triangle whose box touches a tile but covers none of its pixels is still
+    /// binned there; traversal finds no pixel. Each batch holds at most
+    /// [`TriangleRef::MAX_BATCH_TRIANGLES`] triangles, and there are at most
     /// [`TriangleRef::MAX_BATCHES`] batches.
-    pub fn bin_batches(&mut self, grid: &TileGrid, batches: &[&[TriangleSetup]]) -> u64 {
+    pub fn bin_batches(&mut self, grid: &TileGrid, batches: &[&[PixelRect]]) -> u64 {
         use rayon::prelude::*;
         let tile_count = grid.tile_count();
         let total: usize = batches.iter().map(|b| b.len()).sum();
@@ -199,12 +200,11 @@ impl TileBins {
 fn bin_batch(
     grid: &TileGrid,
     batch: usize,
-    triangles: &[TriangleSetup],
+    boxes: &[PixelRect],
     bins: &mut [Vec<TriangleRef>],
 ) -> u64 {
     let mut entries = 0u64;
-    for (index, tri) in triangles.iter().enumerate() {
-        let b = tri.bbox;
+    for (index, &b) in boxes.iter().enumerate() {
         let tx0 = (b.x0 >> TILE_LOG2) as usize;
         let tx1 = ((b.x1 - 1) >> TILE_LOG2) as usize;
         // Only the grid's band of tile rows (all of them for a whole target).
