@@ -30,27 +30,13 @@ pub trait TexelGather: I32x8 {
     fn lookup_rgb(self, table: &[u32; 256]) -> [Self; 3];
 }
 
-/// [`TexelGather::gather_u32_pair`] on plain arrays: the reference.
+/// [`TexelGather::gather_u32_pair`] (`N = 2`) and [`TexelGather::gather_u32_quad`] (`N = 4`)
+/// on plain arrays, the reference: lane `k` of result `i` is `table[c + i]` with
+/// `c = clamp(index[k], 0, table.len() - N)`; all zeros when `table` has fewer than `N` entries.
 #[inline(always)]
-fn gather_pair_reference(index: [i32; 8], table: &[u32]) -> ([i32; 8], [i32; 8]) {
-    let mut first = [0i32; 8];
-    let mut second = [0i32; 8];
-    let Some(last) = table.len().checked_sub(2) else {
-        return (first, second);
-    };
-    for k in 0..8 {
-        let c = usize::try_from(index[k]).unwrap_or(0).min(last);
-        first[k] = table[c] as i32;
-        second[k] = table[c + 1] as i32;
-    }
-    (first, second)
-}
-
-/// [`TexelGather::gather_u32_quad`] on plain arrays: the reference.
-#[inline(always)]
-fn gather_quad_reference(index: [i32; 8], table: &[u32]) -> [[i32; 8]; 4] {
-    let mut out = [[0i32; 8]; 4];
-    let Some(last) = table.len().checked_sub(4) else {
+fn gather_run_reference<const N: usize>(index: [i32; 8], table: &[u32]) -> [[i32; 8]; N] {
+    let mut out = [[0i32; 8]; N];
+    let Some(last) = table.len().checked_sub(N) else {
         return out;
     };
     for k in 0..8 {
@@ -83,14 +69,14 @@ macro_rules! texel_gather_by_reference {
             #[inline(always)]
             fn gather_u32_pair(self, table: &[u32]) -> (Self, Self) {
                 let lanes = self.lanes();
-                let (first, second) = gather_pair_reference(self.to_array(), table);
+                let [first, second] = gather_run_reference::<2>(self.to_array(), table);
                 (lanes.i32_from_array(first), lanes.i32_from_array(second))
             }
 
             #[inline(always)]
             fn gather_u32_quad(self, table: &[u32]) -> [Self; 4] {
                 let lanes = self.lanes();
-                let [a, b, c, d] = gather_quad_reference(self.to_array(), table);
+                let [a, b, c, d] = gather_run_reference::<4>(self.to_array(), table);
                 [
                     lanes.i32_from_array(a),
                     lanes.i32_from_array(b),
@@ -170,32 +156,28 @@ mod tests {
         }
     }
 
-    #[test]
-    fn pairs_are_neighbouring_entries_with_clamped_indices() {
-        let edges = [i32::MIN, -1, 0, 1, 5, 6, 7, 8, 1000, i32::MAX];
-        for len in [0usize, 1, 2, 3, 8, 9] {
+    /// Checks `gather` (a run of `N` neighbouring entries per lane, at every supported level)
+    /// against the clamped reads it must make, over tables of `lens` entries and windows of
+    /// `edges` as indices.
+    fn check_runs<const N: usize>(
+        edges: &[i32],
+        lens: &[usize],
+        gather: impl Fn(Isa, [i32; 8], &[u32]) -> [[i32; 8]; N],
+    ) {
+        for &len in lens {
             let table: Vec<u32> = (0..len as u32)
                 .map(|i| 0x8000_0001u32.wrapping_mul(i + 1))
                 .collect();
             for start in 0..edges.len() {
                 let index: [i32; 8] = std::array::from_fn(|k| edges[(start + k) % edges.len()]);
-                let expected: ([i32; 8], [i32; 8]) = if len < 2 {
-                    ([0; 8], [0; 8])
+                let expected: [[i32; 8]; N] = if len < N {
+                    [[0; 8]; N]
                 } else {
-                    let c = |k: usize| (index[k].max(0) as usize).min(len - 2);
-                    (
-                        std::array::from_fn(|k| table[c(k)] as i32),
-                        std::array::from_fn(|k| table[c(k) + 1] as i32),
-                    )
+                    let c = |k: usize| (index[k].max(0) as usize).min(len - N);
+                    std::array::from_fn(|i| std::array::from_fn(|k| table[c(k) + i] as i32))
                 };
                 for isa in Isa::supported() {
-                    let got = dispatch(
-                        isa,
-                        Pair {
-                            index,
-                            table: &table,
-                        },
-                    );
+                    let got = gather(isa, index, &table);
                     assert_eq!(got, expected, "{isa}, {len} entries, {index:?}");
                 }
             }
@@ -203,32 +185,20 @@ mod tests {
     }
 
     #[test]
+    fn pairs_are_neighbouring_entries_with_clamped_indices() {
+        let edges = [i32::MIN, -1, 0, 1, 5, 6, 7, 8, 1000, i32::MAX];
+        check_runs::<2>(&edges, &[0, 1, 2, 3, 8, 9], |isa, index, table| {
+            let (first, second) = dispatch(isa, Pair { index, table });
+            [first, second]
+        });
+    }
+
+    #[test]
     fn quads_are_four_neighbouring_entries_with_clamped_indices() {
         let edges = [i32::MIN, -1, 0, 1, 3, 4, 5, 6, 7, 8, 1000, i32::MAX];
-        for len in [0usize, 1, 3, 4, 5, 8, 9, 17] {
-            let table: Vec<u32> = (0..len as u32)
-                .map(|i| 0x8000_0001u32.wrapping_mul(i + 1))
-                .collect();
-            for start in 0..edges.len() {
-                let index: [i32; 8] = std::array::from_fn(|k| edges[(start + k) % edges.len()]);
-                let expected: [[i32; 8]; 4] = if len < 4 {
-                    [[0; 8]; 4]
-                } else {
-                    let c = |k: usize| (index[k].max(0) as usize).min(len - 4);
-                    std::array::from_fn(|i| std::array::from_fn(|k| table[c(k) + i] as i32))
-                };
-                for isa in Isa::supported() {
-                    let got = dispatch(
-                        isa,
-                        Quad {
-                            index,
-                            table: &table,
-                        },
-                    );
-                    assert_eq!(got, expected, "{isa}, {len} entries, {index:?}");
-                }
-            }
-        }
+        check_runs::<4>(&edges, &[0, 1, 3, 4, 5, 8, 9, 17], |isa, index, table| {
+            dispatch(isa, Quad { index, table })
+        });
     }
 
     #[test]
