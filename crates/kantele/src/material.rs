@@ -759,6 +759,7 @@ mod tests {
     use crate::pipeline::{Indices, Renderer, RendererOptions};
     use crate::scene::Topology;
     use crate::shade::texture::ColorSpace;
+    use crate::simd::Isa;
 
     /// A built-in shader with the default lane program only: its own `fragment_lanes`, never a
     /// specialised program.
@@ -782,8 +783,17 @@ mod tests {
 
     /// The colour bits of a 96 × 64 frame of `mesh` drawn with `shader`.
     fn render<S: Shader<Vertex = StandardVertex>>(shader: &S, mesh: &Mesh) -> Vec<u32> {
+        render_with(shader, mesh, RendererOptions::default())
+    }
+
+    /// [`render`] with `options`.
+    fn render_with<S: Shader<Vertex = StandardVertex>>(
+        shader: &S,
+        mesh: &Mesh,
+        options: RendererOptions,
+    ) -> Vec<u32> {
         let (vertices, indices) = StandardVertex::from_mesh(mesh);
-        let mut renderer = Renderer::new(96, 64, RendererOptions::default()).expect("renderer");
+        let mut renderer = Renderer::new(96, 64, options).expect("renderer");
         let mut frame = renderer.begin_frame(Some(Vec4::new(0.1, 0.2, 0.3, 1.0)), Some(1.0));
         let state = RenderState {
             cull: CullMode::None,
@@ -801,6 +811,64 @@ mod tests {
         frame.try_end().expect("frame");
         let color = renderer.framebuffer().read_color();
         color.iter().flatten().map(|v| v.to_bits()).collect()
+    }
+
+    /// A face of one vertex colour (a flat-coloured quad, as in the thesis' fill scenes) comes
+    /// out as exactly that colour through the untextured lane program, on every instruction
+    /// set, although the receding quad's perspective weights do not sum to 1 exactly.
+    #[test]
+    fn a_constant_vertex_colour_is_shaded_exactly() {
+        let color = Vec4::new(0.15, 0.682_239_9, 1.0, 1.0);
+        let mesh = Mesh {
+            positions: vec![
+                Vec3::new(-1.0, -0.6, 0.5),
+                Vec3::new(1.0, -0.6, 0.5),
+                Vec3::new(1.0, 0.4, -8.0),
+                Vec3::new(-1.0, 0.4, -8.0),
+            ],
+            colors: Some(vec![color; 4]),
+            indices: vec![0, 1, 2, 0, 2, 3],
+            ..Mesh::default()
+        };
+        let view_projection = Mat4::perspective_rh(1.0, 1.5, 0.1, 20.0)
+            * Mat4::look_at_rh(Vec3::new(0.0, 0.6, 1.6), Vec3::new(0.0, 0.0, -2.0), Vec3::Y);
+        let material = Material {
+            unlit: true,
+            ..Material::default()
+        };
+        let lighting = Lighting {
+            to_light: Vec3::Y,
+            light_color: Vec3::ONE,
+            ambient: 0.0,
+        };
+        let shader = MaterialShader::new(
+            Mat4::IDENTITY,
+            view_projection,
+            lighting,
+            &material,
+            None,
+            Pass::Color,
+            (1, 1),
+        );
+        assert!(shader.untextured_color.is_some());
+        let expected = color.to_array().map(f32::to_bits);
+        for isa in Isa::supported() {
+            let options = RendererOptions {
+                isa: Some(isa),
+                ..RendererOptions::default()
+            };
+            let bits = render_with(&shader, &mesh, options);
+            let background = 0.3f32.to_bits();
+            let drawn: Vec<&[u32]> = bits
+                .chunks_exact(4)
+                .filter(|c| c[2] != background)
+                .collect();
+            assert!(drawn.len() > 1000, "{isa}: {} pixels drawn", drawn.len());
+            assert!(
+                drawn.iter().all(|c| *c == expected),
+                "{isa}: a pixel differs"
+            );
+        }
     }
 
     /// Every specialised lane program (untextured and textured, lit and unlit, with and without

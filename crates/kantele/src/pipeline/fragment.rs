@@ -14,7 +14,8 @@ use super::draw::{DrawCall, DrawJob};
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
 use super::shader::{
-    vertex_varyings, FragmentLanes, Interpolation, LaneProgram, LaneProgramJob, Shader,
+    constant_varyings, vertex_varyings, FragmentLanes, Interpolation, LaneProgram, LaneProgramJob,
+    Shader,
 };
 use crate::fixed::pixel_center;
 use crate::raster::bin::{TileBins, TriangleRef};
@@ -169,10 +170,10 @@ impl<S: Shader> LaneProgramJob for ShadeTriangleJob<'_, '_, S> {
             && state.depth_write
             && state.blend == BlendMode::Replace;
         macro_rules! shade {
-            ($opaque_less:literal) => {
+            ($opaque_less:literal, $constant:literal) => {
                 dispatch(
                     self.isa,
-                    ShadeTriangle::<S, P, $opaque_less> {
+                    ShadeTriangle::<S, P, $opaque_less, $constant> {
                         draw: self.draw,
                         program,
                         tri: self.tri,
@@ -183,10 +184,12 @@ impl<S: Shader> LaneProgramJob for ShadeTriangleJob<'_, '_, S> {
                 )
             };
         }
-        if opaque_less {
-            shade!(true)
-        } else {
-            shade!(false)
+        let constant = constant_varyings(self.attrs);
+        match (opaque_less, constant) {
+            (true, false) => shade!(true, false),
+            (true, true) => shade!(true, true),
+            (false, false) => shade!(false, false),
+            (false, true) => shade!(false, true),
         }
     }
 }
@@ -312,8 +315,19 @@ impl<L: Lanes> ClearLanes<L> {
 
 /// One triangle in one tile, as a kernel compiled per instruction set and lane program, and
 /// once more for the state of most draws (`OPAQUE_LESS`: depth test LESS with depth writes, no
-/// blending), whose per-row tests of that state are then decided at compile time.
-struct ShadeTriangle<'k, 'a, S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> {
+/// blending), whose per-row tests of that state are then decided at compile time. `CONSTANT`
+/// triangles (every varying the same at the three vertices: [`Interpolation::constant`]) have
+/// kernels of their own, which read each varying as that value: a program that reads only
+/// varyings then computes no perspective weights (no division per row), and the other kernels
+/// test nothing for it per row.
+struct ShadeTriangle<
+    'k,
+    'a,
+    S: Shader,
+    P: LaneProgram,
+    const OPAQUE_LESS: bool,
+    const CONSTANT: bool,
+> {
     draw: &'k DrawCall<'a, S>,
     program: &'k P,
     tri: &'k TriangleSetup,
@@ -322,8 +336,8 @@ struct ShadeTriangle<'k, 'a, S: Shader, P: LaneProgram, const OPAQUE_LESS: bool>
     tile: &'k mut TileBuffer,
 }
 
-impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> LaneKernel
-    for ShadeTriangle<'_, '_, S, P, OPAQUE_LESS>
+impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> LaneKernel
+    for ShadeTriangle<'_, '_, S, P, OPAQUE_LESS, CONSTANT>
 {
     type Output = RasterCounters;
 
@@ -347,6 +361,7 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> LaneKernel
             inv_w: tri.inv_w,
             dl_dx,
             dl_dy,
+            constant: CONSTANT,
         };
         let triangle = TriangleLanes::new(lanes, tri);
         let (zero, one) = (triangle.zero, triangle.one);
@@ -429,6 +444,7 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> LaneKernel
                         front_facing: tri.front_facing(),
                         weights,
                         w,
+                        constant: CONSTANT,
                         interpolation: &interpolation,
                     };
                     let shaded = program.fragment_lanes(&fragments);

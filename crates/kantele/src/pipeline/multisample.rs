@@ -22,7 +22,7 @@ use super::draw::{DrawCall, DrawJob};
 use super::fragment::{binned_triangles, RasterCounters, TriangleLanes};
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
-use super::shader::{vertex_varyings, FragmentLanes, Interpolation, Shader};
+use super::shader::{constant_varyings, vertex_varyings, FragmentLanes, Interpolation, Shader};
 use crate::fixed::{pixel_center, BLOCK_SIZE, TILE_SIZE};
 use crate::raster::bin::TileBins;
 use crate::raster::samples::{rasterize_samples, SampleCoverage, MAX_COVERAGE_PLANES};
@@ -134,6 +134,7 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
             inv_w: tri.inv_w,
             dl_dx,
             dl_dy,
+            constant: constant_varyings(attrs),
         };
         let triangle = TriangleLanes::new(lanes, tri);
         let (zero, one) = (triangle.zero, triangle.one);
@@ -209,6 +210,7 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                     front_facing: tri.front_facing(),
                     weights,
                     w,
+                    constant: interpolation.constant,
                     interpolation: &interpolation,
                 };
                 let shaded = shader.fragment_lanes(&fragments);

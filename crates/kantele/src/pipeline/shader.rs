@@ -222,6 +222,19 @@ pub(crate) fn vertex_varyings(attrs: &[f32]) -> VertexVaryings {
     out
 }
 
+/// Whether every varying has the same bits at the three vertices ([`Interpolation::constant`]);
+/// `attrs` is vertex-major, as [`vertex_varyings`] reads it.
+#[inline]
+pub(crate) fn constant_varyings(attrs: &[f32]) -> bool {
+    let n = attrs.len() / 3;
+    let (v0, rest) = attrs.split_at(n);
+    let (v1, v2) = rest.split_at(n);
+    v0.iter()
+        .zip(v1)
+        .zip(v2)
+        .all(|((a, b), c)| a.to_bits() == b.to_bits() && b.to_bits() == c.to_bits())
+}
+
 /// Per-triangle data for interpolation and derivatives, shared by [`Fragment`] and
 /// [`FragmentLanes`] so that both evaluate the same formulas.
 pub(crate) struct Interpolation<'a> {
@@ -231,6 +244,23 @@ pub(crate) struct Interpolation<'a> {
     pub(crate) inv_w: [f32; 3],
     pub(crate) dl_dx: [f32; 3],
     pub(crate) dl_dy: [f32; 3],
+    /// Every varying has the same bits at the three vertices (a flat-coloured face, a face
+    /// normal, no varyings at all): each is then that value at every pixel, exactly, and
+    /// nothing is interpolated (no perspective weights, no division).
+    pub(crate) constant: bool,
+}
+
+impl Interpolation<'_> {
+    /// Varying `index` from perspective-correct `weights`: `Σ weight_i · a_i`, or the vertices'
+    /// common value where every varying is [`Interpolation::constant`].
+    #[inline(always)]
+    fn interpolate(&self, index: usize, weights: [f32; 3]) -> f32 {
+        let a = self.attrs[index];
+        if self.constant {
+            return a[0];
+        }
+        weights[0] * a[0] + weights[1] * a[1] + weights[2] * a[2]
+    }
 }
 
 /// What the fragment stage sees of up to eight horizontally adjacent pixels of one row: lane `k`
@@ -250,8 +280,14 @@ pub struct FragmentLanes<'a, L: Lanes> {
     pub primitive_id: u32,
     /// Whether the triangle faces the viewer.
     pub front_facing: bool,
+    /// Perspective-correct weights of the three vertices and the lanes' clip `w`. A kernel for
+    /// constant triangles computes them too; where its program reads only varyings, the
+    /// compiler removes them (and their division) as unused.
     pub(crate) weights: [L::F32; 3],
     pub(crate) w: L::F32,
+    /// [`Interpolation::constant`], held here so that a kernel compiled for constant
+    /// triangles decides it at compile time.
+    pub(crate) constant: bool,
     pub(crate) interpolation: &'a Interpolation<'a>,
 }
 
@@ -263,11 +299,16 @@ pub(crate) struct PerLane {
 }
 
 impl<'a, L: Lanes> FragmentLanes<'a, L> {
-    /// Interpolated varying `index` (perspective-correct): `Σ weight_i · a_i`.
+    /// Interpolated varying `index` (perspective-correct): `Σ weight_i · a_i`; on a triangle
+    /// whose varyings are all constant ([`Interpolation::constant`]), the vertices' value.
     #[inline(always)]
     pub fn varying(&self, index: usize) -> L::F32 {
         let a = self.interpolation.attrs[index];
         let lanes = self.lanes;
+        // Decided at compile time by the 1× kernel (compiled once more for constant triangles).
+        if self.constant {
+            return lanes.splat_f32(a[0]);
+        }
         self.weights[0] * lanes.splat_f32(a[0])
             + self.weights[1] * lanes.splat_f32(a[1])
             + self.weights[2] * lanes.splat_f32(a[2])
@@ -330,8 +371,8 @@ impl<'a, L: Lanes> FragmentLanes<'a, L> {
             per_lane.weights[1][k],
             per_lane.weights[2][k],
         ];
-        for (v, a) in varyings[..n].iter_mut().zip(ip.attrs) {
-            *v = weights[0] * a[0] + weights[1] * a[1] + weights[2] * a[2];
+        for (index, v) in varyings[..n].iter_mut().enumerate() {
+            *v = ip.interpolate(index, weights);
         }
         Fragment {
             x: self.x + k as u32,

@@ -118,6 +118,48 @@ fn perspective_correct_attributes_match_the_analytic_mapping() {
     assert!(checked > 4000, "{checked}");
 }
 
+/// A triangle whose attributes are the same at its three vertices reads them as exactly that
+/// value at every pixel, on every instruction set, although its perspective weights do not sum
+/// to 1 exactly everywhere.
+#[test]
+fn constant_attributes_are_read_exactly() {
+    let (w, h) = (160, 120);
+    let view_proj = perspective(1.0, w as f32 / h as f32, 0.1, 100.0)
+        * look_at(Vec3::new(0.0, 1.0, 3.0), Vec3::new(0.0, 0.0, -2.0), Vec3::Y);
+    let shader = attribute_shader(view_proj);
+    let constant = Vec2::new(0.1, 0.7);
+    // The ground's first triangle, receding, with the same attribute at its three vertices.
+    let triangle: Vec<Vtx> = ground(4.0)[..3]
+        .iter()
+        .map(|&(position, _)| (position, constant))
+        .collect();
+    for isa in kantele::simd::Isa::supported() {
+        let options = RendererOptions {
+            isa: Some(isa),
+            ..RendererOptions::default()
+        };
+        let mut renderer = Renderer::new(w, h, options).expect("renderer");
+        let mut frame = renderer.begin_frame(Some(Vec4::ONE), Some(1.0));
+        frame
+            .draw(&shader, &triangle, Indices::None, no_cull())
+            .expect("draw");
+        frame.end();
+        let fb = renderer.framebuffer();
+        let mut covered = 0;
+        for y in 0..h {
+            for x in 0..w {
+                let got = fb.pixel(x, y).expect("pixel");
+                if got.z != 0.0 {
+                    continue; // the clear colour
+                }
+                assert_eq!(got.truncate().truncate(), constant, "{isa} at ({x}, {y})");
+                covered += 1;
+            }
+        }
+        assert!(covered > w * h / 5, "{isa}: {covered} pixels covered");
+    }
+}
+
 #[test]
 fn a_triangle_reaching_behind_the_eye_renders_its_visible_part() {
     // The ground plane extends far behind the camera: the near clipper must cut it, and the
