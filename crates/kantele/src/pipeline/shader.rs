@@ -300,7 +300,7 @@ pub(crate) struct PerLane {
 
 impl<'a, L: Lanes> FragmentLanes<'a, L> {
     /// Interpolated varying `index` (perspective-correct): `Σ weight_i · a_i`; on a triangle
-    /// whose varyings are all constant ([`Interpolation::constant`]), the vertices' value.
+    /// whose every varying has the same bits at its three vertices, exactly that value.
     #[inline(always)]
     pub fn varying(&self, index: usize) -> L::F32 {
         let a = self.interpolation.attrs[index];
