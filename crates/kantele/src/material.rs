@@ -382,6 +382,10 @@ struct OpaqueTextured<'s, 'a, const UNLIT: bool, const VERTEX_COLORS: bool> {
 impl<const UNLIT: bool, const VERTEX_COLORS: bool> LaneProgram
     for OpaqueTextured<'_, '_, UNLIT, VERTEX_COLORS>
 {
+    /// A texture coordinate is rarely the same at a triangle's three vertices, and the sampler
+    /// makes these the largest kernels: compiled once.
+    const CONSTANT_KERNELS: bool = false;
+
     #[inline(always)]
     fn fragment_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
         let (shader, lanes) = (self.shader, f.lanes);

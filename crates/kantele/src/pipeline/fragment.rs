@@ -184,8 +184,16 @@ impl<S: Shader> LaneProgramJob for ShadeTriangleJob<'_, '_, S> {
                 )
             };
         }
-        let constant = constant_varyings(self.attrs);
-        match (opaque_less, constant) {
+        // `P::CONSTANT_KERNELS` is known when the kernel is compiled: a program that opts out
+        // has no constant kernels compiled at all.
+        if !P::CONSTANT_KERNELS {
+            return if opaque_less {
+                shade!(true, false)
+            } else {
+                shade!(false, false)
+            };
+        }
+        match (opaque_less, constant_varyings(self.attrs)) {
             (true, false) => shade!(true, false),
             (true, true) => shade!(true, true),
             (false, false) => shade!(false, false),
@@ -317,7 +325,8 @@ impl<L: Lanes> ClearLanes<L> {
 /// once more for the state of most draws (`OPAQUE_LESS`: depth test LESS with depth writes, no
 /// blending), whose per-row tests of that state are then decided at compile time. `CONSTANT`
 /// triangles (every varying the same at the three vertices: [`Interpolation::constant`]) have
-/// kernels of their own, which read each varying as that value: a program that reads only
+/// kernels of their own, unless the program opts out ([`LaneProgram::CONSTANT_KERNELS`]),
+/// which read each varying as that value: a program that reads only
 /// varyings then computes no perspective weights (no division per row), and the other kernels
 /// test nothing for it per row.
 struct ShadeTriangle<

@@ -79,6 +79,15 @@ pub trait Shader: Send + Sync {
 /// A lane-wide fragment program, as the per-pixel kernel calls it for each row of eight pixels
 /// (see [`Shader::with_lane_program`]).
 pub trait LaneProgram: Sync {
+    /// Whether the per-pixel kernel is compiled a second time for this program, for triangles
+    /// whose varyings are all the same at the three vertices (a flat-coloured face): there
+    /// [`FragmentLanes::varying`] is that value exactly, and a program that reads only varyings
+    /// computes no perspective weights. A program that opts out (`false`) has one kernel, in
+    /// which such triangles are interpolated like any other (`Σ weight_i · a_i`, within an ulp
+    /// of the value); worth it for programs whose triangles are rarely constant and whose
+    /// kernels are large (the textured ones).
+    const CONSTANT_KERNELS: bool = true;
+
     /// Shades the active lanes of one row, as [`Shader::fragment_lanes`].
     fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L>;
 }
