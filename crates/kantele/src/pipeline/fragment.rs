@@ -453,7 +453,6 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
                         front_facing: tri.front_facing(),
                         weights,
                         w,
-                        constant: CONSTANT,
                         interpolation: &interpolation,
                     };
                     let shaded = program.fragment_lanes(&fragments);

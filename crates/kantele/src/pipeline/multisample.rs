@@ -210,7 +210,6 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                     front_facing: tri.front_facing(),
                     weights,
                     w,
-                    constant: interpolation.constant,
                     interpolation: &interpolation,
                 };
                 let shaded = shader.fragment_lanes(&fragments);

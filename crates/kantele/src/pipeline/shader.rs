@@ -294,9 +294,6 @@ pub struct FragmentLanes<'a, L: Lanes> {
     /// compiler removes them (and their division) as unused.
     pub(crate) weights: [L::F32; 3],
     pub(crate) w: L::F32,
-    /// [`Interpolation::constant`], held here so that a kernel compiled for constant
-    /// triangles decides it at compile time.
-    pub(crate) constant: bool,
     pub(crate) interpolation: &'a Interpolation<'a>,
 }
 
@@ -314,8 +311,8 @@ impl<'a, L: Lanes> FragmentLanes<'a, L> {
     pub fn varying(&self, index: usize) -> L::F32 {
         let a = self.interpolation.attrs[index];
         let lanes = self.lanes;
-        // Decided at compile time by the 1× kernel (compiled once more for constant triangles).
-        if self.constant {
+        // A compile-time constant in the 1× kernel (compiled once more for constant triangles).
+        if self.interpolation.constant {
             return lanes.splat_f32(a[0]);
         }
         self.weights[0] * lanes.splat_f32(a[0])
