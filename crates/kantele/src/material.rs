@@ -17,7 +17,7 @@ use crate::pipeline::{
 use crate::rop::BlendMode;
 use crate::scene::{AlphaMode, Material, Mesh};
 use crate::setup::CullMode;
-use crate::shade::sample_lanes::TrilinearRepeat16;
+use crate::shade::sample_lanes::TrilinearRepeat15;
 use crate::shade::texture::{Sampler, Texture};
 use crate::simd::{F32x8, Lanes, Mask8};
 
@@ -358,25 +358,25 @@ impl Shader for MaterialShader<'_> {
 
 impl<'a> MaterialShader<'a> {
     /// The base colour texture of an opaque colour-pass draw without an emissive texture, when
-    /// it is sampled in the [`TrilinearRepeat16`] configuration ([`OpaqueTextured`] then shades
+    /// it is sampled in the [`TrilinearRepeat15`] configuration ([`OpaqueTextured`] then shades
     /// the draw).
-    fn opaque_textured(&self) -> Option<TrilinearRepeat16<'a>> {
+    fn opaque_textured(&self) -> Option<TrilinearRepeat15<'a>> {
         let plain = self.pass == Pass::Color
             && self.emissive_texture.is_none()
             && matches!(self.material.alpha_mode, AlphaMode::Opaque);
         let (texture, sampler) = self.texture.filter(|_| plain)?;
-        texture.trilinear_repeat16(&sampler)
+        texture.trilinear_repeat15(&sampler)
     }
 }
 
 /// The lane program of an opaque colour-pass draw whose base colour texture is sampled in the
-/// [`TrilinearRepeat16`] configuration, without an emissive texture, with lighting (`UNLIT`) and
+/// [`TrilinearRepeat15`] configuration, without an emissive texture, with lighting (`UNLIT`) and
 /// vertex colours (`VERTEX_COLORS`) fixed at compile time: the operations of
 /// [`MaterialShader::shade_lanes`] for such a draw, in the same order, with no branch on the
 /// material, the pass, the wrap modes, the filters or the texel storage.
 struct OpaqueTextured<'s, 'a, const UNLIT: bool, const VERTEX_COLORS: bool> {
     shader: &'s MaterialShader<'a>,
-    texture: TrilinearRepeat16<'a>,
+    texture: TrilinearRepeat15<'a>,
 }
 
 impl<const UNLIT: bool, const VERTEX_COLORS: bool> LaneProgram
@@ -888,7 +888,7 @@ mod tests {
             .collect();
         let texture = Texture::from_rgba8(64, 64, &rgba, ColorSpace::Srgb).expect("texture");
         texture.prepare_lane_sampling();
-        let sampler = TrilinearRepeat16::SAMPLER;
+        let sampler = TrilinearRepeat15::SAMPLER;
         let mesh = |colors: bool| Mesh {
             positions: vec![
                 Vec3::new(-1.0, -0.6, 0.5),

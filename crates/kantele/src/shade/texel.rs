@@ -62,35 +62,40 @@ pub fn decode_table(color_space: ColorSpace) -> &'static [u32; 256] {
     }
 }
 
-/// The linear value of an sRGB byte in 16-bit units, `round(srgb_to_linear(k / 255) · 65535)`:
-/// what the lane-wide sampler filters for the red, green and blue channels of sRGB textures (as
-/// integers in `f32`, divided by 65535 once after filtering). Every byte survives the round trip
-/// through it back to 8-bit sRGB.
+/// The fixed-point unit the lane-wide sampler filters in: a channel value `v` stands for
+/// `v / LINEAR15_SCALE`. `255 · 128`, so a linear byte `k` is exactly `k · 128` units; below
+/// 2^15, so two values and a 15-bit weight fit the 16-bit multiplies of the SIMD filter.
+pub const LINEAR15_SCALE: u32 = 255 * 128;
+
+/// The linear value of an sRGB byte in units of 1/[`LINEAR15_SCALE`],
+/// `round(srgb_to_linear(k / 255) · 32640)`: what the lane-wide sampler filters for the red,
+/// green and blue channels of sRGB textures (as integers, scaled to [0, 1] once after
+/// filtering). Every byte survives the round trip through it back to 8-bit sRGB.
 #[inline]
-pub fn srgb_to_linear16(k: u8) -> u16 {
-    (srgb_to_linear(k as f32 / 255.0) * 65535.0).round() as u16
+pub fn srgb_to_linear15(k: u8) -> u16 {
+    (srgb_to_linear(k as f32 / 255.0) * LINEAR15_SCALE as f32).round() as u16
 }
 
-/// [`srgb_to_linear16`] of every byte as the `f32` bit patterns of those integers, for the
-/// lane-wide sampler's gathers. Built once per process.
-pub fn linear16_table() -> &'static [u32; 256] {
+/// [`srgb_to_linear15`] of every byte, for the lane-wide sampler's gathers. Built once per
+/// process.
+pub fn linear15_table() -> &'static [u32; 256] {
     static TABLE: OnceLock<[u32; 256]> = OnceLock::new();
-    TABLE.get_or_init(|| std::array::from_fn(|k| (srgb_to_linear16(k as u8) as f32).to_bits()))
+    TABLE.get_or_init(|| std::array::from_fn(|k| srgb_to_linear15(k as u8) as u32))
 }
 
-/// An sRGB texel decoded to 16 bits per channel, as two words `[r | g << 16, b | a << 16]`:
-/// red, green and blue by [`srgb_to_linear16`], alpha (linear) as `a · 257` (`a / 255` in units
-/// of 1/65535, exactly).
+/// An sRGB texel decoded to units of 1/[`LINEAR15_SCALE`], as two words
+/// `[r | g << 16, b | a << 16]`: red, green and blue by [`srgb_to_linear15`], alpha (linear) as
+/// `a · 128` (`a / 255` exactly).
 #[inline]
-pub fn srgb_texel_to_linear16(texel: u32) -> [u32; 2] {
-    let table = linear16_table();
+pub fn srgb_texel_to_linear15(texel: u32) -> [u32; 2] {
+    let table = linear15_table();
     let [r, g, b, a] = unpack_rgba8(texel);
-    // The table's entries are exact integers below 2^16 (`srgb_to_linear16`): read them back
-    // rather than evaluate `powf` per channel of every texel (a 2048² texture has 5.6 M).
-    let linear = |byte: u8| f32::from_bits(table[byte as usize]) as u32;
+    // The table holds `srgb_to_linear15` of every byte: read it rather than evaluate `powf` per
+    // channel of every texel (a 2048² texture has 5.6 M).
+    let linear = |byte: u8| table[byte as usize];
     [
         linear(r) | linear(g) << 16,
-        linear(b) | (a as u32 * 257) << 16,
+        linear(b) | (a as u32 * 128) << 16,
     ]
 }
 
@@ -127,23 +132,27 @@ mod tests {
     }
 
     #[test]
-    fn sixteen_bit_decoding_keeps_every_byte() {
-        let table = linear16_table();
-        let mut previous = -1.0f32;
+    fn fifteen_bit_decoding_keeps_every_byte() {
+        let table = linear15_table();
+        let scale = LINEAR15_SCALE as f32;
+        let mut previous = -1i64;
         for k in 0..=255u8 {
-            let value = f32::from_bits(table[k as usize]);
-            assert_eq!(value, srgb_to_linear16(k) as f32);
-            assert!(value > previous, "increasing at {k}");
-            previous = value;
+            let value = table[k as usize];
+            assert_eq!(value, srgb_to_linear15(k) as u32);
+            assert!(value as i64 > previous, "increasing at {k}");
+            previous = value as i64;
             // Within half a unit of the exact decode, and back to the same byte.
-            let exact = srgb_to_linear(k as f32 / 255.0) * 65535.0;
-            assert!((value - exact).abs() <= 0.5, "{k}: {value} vs {exact}");
-            assert_eq!(unorm8(linear_to_srgb(value / 65535.0)), k);
+            let exact = srgb_to_linear(k as f32 / 255.0) * scale;
+            assert!(
+                (value as f32 - exact).abs() <= 0.5,
+                "{k}: {value} vs {exact}"
+            );
+            assert_eq!(unorm8(linear_to_srgb(value as f32 / scale)), k);
         }
-        assert_eq!(srgb_to_linear16(255), 65535);
-        let [rg, ba] = srgb_texel_to_linear16(pack_rgba8([255, 0, 188, 128]));
-        assert_eq!(rg, 65535);
-        assert_eq!(ba, srgb_to_linear16(188) as u32 | (128 * 257) << 16);
+        assert_eq!(srgb_to_linear15(255) as u32, LINEAR15_SCALE);
+        let [rg, ba] = srgb_texel_to_linear15(pack_rgba8([255, 0, 188, 128]));
+        assert_eq!(rg, LINEAR15_SCALE);
+        assert_eq!(ba, srgb_to_linear15(188) as u32 | (128 * 128) << 16);
     }
 
     #[test]

@@ -12,10 +12,10 @@
 //! Two samplers read that storage: the scalar [`Texture::sample_grad`] / [`Texture::sample_lod`]
 //! (for user shaders, one pixel at a time) and the lane-wide [`Texture::sample_grad_lanes`]
 //! (eight pixels at a time, used by the built-in materials). They apply the same rules; their
-//! results may differ in the last bits (the lane sampler computes `log2` with a polynomial,
-//! filters linear channels as bytes and sRGB channels as 16-bit linear values, and scales them
-//! to [0, 1] after filtering). The lane sampler keeps a small sRGB texture's texels decoded to
-//! those 16-bit values (8 bytes a texel, built once: [`Texture::prepare_lane_sampling`]), so it
+//! results may differ by about 1e-4 (the lane sampler computes `log2` with a polynomial and
+//! filters in fixed point, channels in units of 1/32640 and weights in units of 1/32768, and
+//! scales to [0, 1] after filtering). The lane sampler keeps a small sRGB texture's texels
+//! decoded to those units (8 bytes a texel, built once: [`Texture::prepare_lane_sampling`]), so it
 //! reads them without a table lookup per channel; larger ones (level 0 over 2048 × 2048) keep to
 //! 4 bytes a texel and the table.
 
@@ -24,7 +24,7 @@ use std::sync::OnceLock;
 use glam::{Vec2, Vec4};
 
 use super::texel::{
-    decode_table, decode_texel, encode_texel, pack_rgba8, srgb_texel_to_linear16, unpack_rgba8,
+    decode_table, decode_texel, encode_texel, pack_rgba8, srgb_texel_to_linear15, unpack_rgba8,
 };
 use crate::error::RenderError;
 
@@ -32,8 +32,9 @@ use crate::error::RenderError;
 pub const MAX_TEXTURE_SIZE: u32 = 16384;
 
 /// Largest level 0 (texels) of an sRGB texture whose texels the lane-wide sampler keeps decoded
-/// to 16 bits ([`Texture::prepare_lane_sampling`]): 2048 × 2048, a copy of at most 45 MB.
-const LINEAR16_MAX_TEXELS: usize = 2048 * 2048;
+/// to 15-bit linear units ([`Texture::prepare_lane_sampling`]): 2048 × 2048, a copy of at most
+/// 45 MB.
+const LINEAR15_MAX_TEXELS: usize = 2048 * 2048;
 
 /// How the 8-bit channels of an image are encoded.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -91,10 +92,10 @@ pub struct Texture {
     pub(super) texels: Vec<u32>,
     pub(super) levels: LevelTable,
     pub(super) color_space: ColorSpace,
-    /// An sRGB texture's texels decoded to 16 bits per channel, two words per texel
-    /// ([`srgb_texel_to_linear16`]), same layout as `texels`: built on first use by the lane-wide
-    /// sampler, for textures up to [`LINEAR16_MAX_TEXELS`] (see [`Texture::linear16`]).
-    linear16: OnceLock<Vec<u32>>,
+    /// An sRGB texture's texels decoded to 15-bit linear units, 16 bits per channel, two words per texel
+    /// ([`srgb_texel_to_linear15`]), same layout as `texels`: built on first use by the lane-wide
+    /// sampler, for textures up to [`LINEAR15_MAX_TEXELS`] (see [`Texture::linear15`]).
+    linear15: OnceLock<Vec<u32>>,
 }
 
 impl std::fmt::Debug for Texture {
@@ -179,7 +180,7 @@ impl Texture {
             texels,
             levels,
             color_space,
-            linear16: OnceLock::new(),
+            linear15: OnceLock::new(),
         }
     }
 
@@ -188,21 +189,21 @@ impl Texture {
     /// of decoding each texel through a table; the results are the same). Backends that sample
     /// lane-wide call it when a scene is loaded, so that no frame pays for it.
     pub fn prepare_lane_sampling(&self) {
-        let _ = self.linear16();
+        let _ = self.linear15();
     }
 
-    /// The texels decoded to 16 bits (two words per texel, [`srgb_texel_to_linear16`]) for an
-    /// sRGB texture whose level 0 holds at most [`LINEAR16_MAX_TEXELS`] texels, built on first
+    /// The texels decoded to 15-bit linear units (two words per texel, [`srgb_texel_to_linear15`]) for an
+    /// sRGB texture whose level 0 holds at most [`LINEAR15_MAX_TEXELS`] texels, built on first
     /// use; `None` for linear and larger textures.
-    pub(super) fn linear16(&self) -> Option<&[u32]> {
-        let small = self.width() as usize * self.height() as usize <= LINEAR16_MAX_TEXELS;
+    pub(super) fn linear15(&self) -> Option<&[u32]> {
+        let small = self.width() as usize * self.height() as usize <= LINEAR15_MAX_TEXELS;
         if self.color_space != ColorSpace::Srgb || !small {
             return None;
         }
-        let words = self.linear16.get_or_init(|| {
+        let words = self.linear15.get_or_init(|| {
             self.texels
                 .iter()
-                .flat_map(|&t| srgb_texel_to_linear16(t))
+                .flat_map(|&t| srgb_texel_to_linear15(t))
                 .collect()
         });
         Some(words)
@@ -249,7 +250,7 @@ impl Texture {
     /// Bytes of memory the texture holds: the texels of every level, the level table and, once
     /// built, the lane-wide sampler's decoded copy ([`Texture::prepare_lane_sampling`]).
     pub fn memory_bytes(&self) -> usize {
-        let decoded = self.linear16.get().map_or(0, Vec::capacity);
+        let decoded = self.linear15.get().map_or(0, Vec::capacity);
         std::mem::size_of::<Self>()
             + (self.texels.capacity() + decoded) * std::mem::size_of::<u32>()
             + 3 * self.levels.offsets.capacity() * std::mem::size_of::<u32>()

@@ -9,7 +9,7 @@ use std::arch::x86_64::*;
 use std::fmt;
 use std::ops::{Add, BitAnd, BitOr, BitXor, Div, Mul, Neg, Not, Sub};
 
-use super::{F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
+use super::{F32x8, Footprint15, I32x8, Isa, LaneKernel, Lanes, Mask8};
 
 /// The AVX2 implementation's token: proof that this CPU runs AVX2.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -564,6 +564,31 @@ impl super::TexelGather for Avx2I32 {
     }
 
     #[inline(always)]
+    fn filter15(
+        words: &[u32],
+        first: Footprint15<Self>,
+        second: Option<(Footprint15<Self>, Self)>,
+    ) -> [Self; 4] {
+        let Some(last) = words.len().checked_sub(4) else {
+            return avx!([Avx2I32(_mm256_setzero_si256()); 4]);
+        };
+        let last = i32::try_from(last).unwrap_or(i32::MAX);
+        let level = filter_level15(words, last, first);
+        let packed = match second {
+            None => level,
+            Some((footprint, weight)) => {
+                let other = filter_level15(words, last, footprint);
+                let [w01, w23] = packed_weights15(weight.0);
+                [
+                    lerp15_packed(level[0], other[0], w01),
+                    lerp15_packed(level[1], other[1], w23),
+                ]
+            }
+        };
+        unpack_packed15(packed)
+    }
+
+    #[inline(always)]
     fn lookup_rgb(self, table: &[u32; 256]) -> [Self; 3] {
         let byte = avx!(_mm256_set1_epi32(0xff));
         let base: *const i32 = table.as_ptr().cast();
@@ -584,4 +609,104 @@ impl super::TexelGather for Avx2I32 {
             )),
         ])
     }
+}
+
+// The packed fixed-point filter of `TexelGather::filter15`. A texel of a decoded copy is four
+// 16-bit channels (8 bytes) and a row's two neighbouring texels are 16 bytes: one load per lane.
+// Lanes are held in pairs, [lane k, lane k + 1 | lane k + 4, lane k + 5] (k = 0 in the first
+// register of a pair, 2 in the second), one 64-bit quarter (four channels) per lane, so that
+// every step is one 16-bit operation on two registers and the result unpacks to lane order.
+
+/// `a + mulhrs(b − a, w)` per 16-bit element: `lerp15` (texel_gather.rs) for values and weights
+/// in `0..=32767` (`vpmulhrsw` is `((x·w >> 14) + 1) >> 1`, which equals `(x·w + 2^14) >> 15`,
+/// and every result fits 16 bits).
+#[inline(always)]
+fn lerp15_packed(a: __m256i, b: __m256i, w: __m256i) -> __m256i {
+    avx!(_mm256_add_epi16(
+        a,
+        _mm256_mulhrs_epi16(_mm256_sub_epi16(b, a), w)
+    ))
+}
+
+/// Per-lane weights (`0..=32767` in each 32-bit lane) repeated over the four 16-bit channels of
+/// each lane, in the two registers' lane order.
+#[inline(always)]
+fn packed_weights15(weight: __m256i) -> [__m256i; 2] {
+    avx!({
+        let both = _mm256_or_si256(weight, _mm256_slli_epi32::<16>(weight));
+        [
+            _mm256_permutevar8x32_epi32(both, _mm256_setr_epi32(0, 0, 1, 1, 4, 4, 5, 5)),
+            _mm256_permutevar8x32_epi32(both, _mm256_setr_epi32(2, 2, 3, 3, 6, 6, 7, 7)),
+        ]
+    })
+}
+
+/// The two texels of one row per lane, from texel index `index` (the word index `2 · index`,
+/// wrapping, clamped to `0..=last` as `gather_u32_quad` clamps it), as `[left, right]` in the
+/// two registers' lane order.
+#[inline(always)]
+fn load_row15(words: &[u32], last: i32, index: __m256i) -> [[__m256i; 2]; 2] {
+    avx!({
+        let word = _mm256_min_epi32(
+            _mm256_max_epi32(_mm256_add_epi32(index, index), _mm256_setzero_si256()),
+            _mm256_set1_epi32(last),
+        );
+        let mut at = [0i32; 8];
+        _mm256_storeu_si256(at.as_mut_ptr().cast(), word);
+        // Every clamped index is in `0..=words.len() - 4`, so every 16-byte read (words
+        // `c..c + 4`) is inside `words`; `c ≥ 0`, so the `usize` conversion is exact.
+        let p = words.as_ptr();
+        let load = |k: usize| -> __m128i { _mm_loadu_si128(p.add(at[k] as usize).cast()) };
+        // Lane `k` in the low half and lane `k + 4` in the high half: [left | right] each.
+        let r0 = _mm256_inserti128_si256::<1>(_mm256_castsi128_si256(load(0)), load(4));
+        let r1 = _mm256_inserti128_si256::<1>(_mm256_castsi128_si256(load(1)), load(5));
+        let r2 = _mm256_inserti128_si256::<1>(_mm256_castsi128_si256(load(2)), load(6));
+        let r3 = _mm256_inserti128_si256::<1>(_mm256_castsi128_si256(load(3)), load(7));
+        [
+            [_mm256_unpacklo_epi64(r0, r1), _mm256_unpacklo_epi64(r2, r3)],
+            [_mm256_unpackhi_epi64(r0, r1), _mm256_unpackhi_epi64(r2, r3)],
+        ]
+    })
+}
+
+/// One level's bilinear filter (`filter_level15_reference`), packed.
+#[inline(always)]
+fn filter_level15(words: &[u32], last: i32, f: Footprint15<Avx2I32>) -> [__m256i; 2] {
+    let alpha = packed_weights15(f.alpha.0);
+    let beta = packed_weights15(f.beta.0);
+    let [left, right] = load_row15(words, last, f.top.0);
+    let top = [
+        lerp15_packed(left[0], right[0], alpha[0]),
+        lerp15_packed(left[1], right[1], alpha[1]),
+    ];
+    let [left, right] = load_row15(words, last, f.bottom.0);
+    let bottom = [
+        lerp15_packed(left[0], right[0], alpha[0]),
+        lerp15_packed(left[1], right[1], alpha[1]),
+    ];
+    [
+        lerp15_packed(top[0], bottom[0], beta[0]),
+        lerp15_packed(top[1], bottom[1], beta[1]),
+    ]
+}
+
+/// Packed channels (lanes [0, 1 | 4, 5] and [2, 3 | 6, 7]) to red, green, blue and alpha lanes
+/// in lane order, zero-extended to 32 bits.
+#[inline(always)]
+fn unpack_packed15([v01, v23]: [__m256i; 2]) -> [Avx2I32; 4] {
+    avx!({
+        // [0r 2r 0g 2g 0b 2b 0a 2a | 4.. 6..] and the same for lanes 1, 3 (5, 7).
+        let even = _mm256_unpacklo_epi16(v01, v23);
+        let odd = _mm256_unpackhi_epi16(v01, v23);
+        // [0r 1r 2r 3r 0g 1g 2g 3g | 4r .. 7r 4g .. 7g] and the same for blue and alpha.
+        let rg = _mm256_unpacklo_epi16(even, odd);
+        let ba = _mm256_unpackhi_epi16(even, odd);
+        let zero = _mm256_setzero_si256();
+        [
+            Avx2I32(_mm256_unpacklo_epi16(rg, zero)),
+            Avx2I32(_mm256_unpackhi_epi16(rg, zero)),
+            Avx2I32(_mm256_unpacklo_epi16(ba, zero)),
+            Avx2I32(_mm256_unpackhi_epi16(ba, zero)),
+        ]
+    })
 }
