@@ -99,7 +99,9 @@ pub use rounding::{floor, round_ties_even};
 pub use scalar::{Scalar, ScalarF32, ScalarI32, ScalarMask};
 #[cfg(target_arch = "x86_64")]
 pub use sse2::{Sse2, Sse41, SseF32, SseI32, SseLevel, SseMask};
-pub use texel_gather::{lerp15, lerp15_channels, unpack_words15, Footprint15, TexelGather};
+pub use texel_gather::{
+    filter15_reference, lerp15, lerp15_channels, unpack_words15, Footprint15, TexelGather,
+};
 
 /// The environment variable that forces an instruction set (see [`Isa::from_env`]).
 pub const ISA_ENV: &str = "KANTELE_ISA";
