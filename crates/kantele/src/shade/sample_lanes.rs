@@ -21,7 +21,9 @@
 //! polynomial here (absolute error below 1e-6 for the level of detail), and each fixed-point
 //! step rounds by at most one unit.
 
-use crate::simd::{lerp15_channels, F32x8, Footprint15, I32x8, Lanes, Mask8, MaskOf, TexelGather};
+use crate::simd::{
+    bilinear15, lerp15_channels, F32x8, Footprint15, I32x8, Lanes, Mask8, MaskOf, TexelGather,
+};
 
 use super::texel::{linear15_table, LINEAR15_SCALE};
 use super::texel_lanes::{Channels, TexelSource};
@@ -314,11 +316,15 @@ impl TrilinearRepeat15<'_> {
 /// `0..=32767` (a weight that rounds to 1 gives the second value 32767/32768 of the blend).
 #[inline(always)]
 fn weight15<L: Lanes>(w: L::F32) -> L::I32 {
-    let lanes = w.lanes();
-    (w * lanes.splat_f32(32768.0))
+    fixed15::<L>(w).min(w.lanes().splat_i32(32767))
+}
+
+/// `x` in units of 1/32768, rounded to the nearest (ties to even); `x · 32768` must fit `i32`.
+#[inline(always)]
+fn fixed15<L: Lanes>(x: L::F32) -> L::I32 {
+    (x * x.lanes().splat_f32(32768.0))
         .round_ties_even()
         .to_i32_trunc()
-        .min(lanes.splat_i32(32767))
 }
 
 /// A texel coordinate `u` (a [`LaneAxis`] coordinate less the half texel) rounded to 1/32768 of
@@ -329,9 +335,7 @@ fn weight15<L: Lanes>(w: L::F32) -> L::I32 {
 #[inline(always)]
 fn fixed_texel<L: Lanes>(u: L::F32, nearest: MaskOf<L>) -> (L::I32, L::I32) {
     let lanes = u.lanes();
-    let fixed = (u * lanes.splat_f32(32768.0))
-        .round_ties_even()
-        .to_i32_trunc();
+    let fixed = fixed15::<L>(u);
     let (whole, fraction) = (fixed.shr_arith::<15>(), fixed & lanes.splat_i32(32767));
     if nearest.none() {
         return (whole, fraction);
@@ -361,21 +365,20 @@ impl TexelSource<'_> {
     fn filter<L: Lanes>(self, texels: &LevelTexels<L>) -> Channels<L> {
         let (f, right) = match *texels {
             LevelTexels::Nearest(index) => return self.fetch::<L>(index),
-            LevelTexels::Bilinear(f) => {
-                if let TexelSource::Linear15(words) = self {
-                    return <L::I32 as TexelGather>::filter15(words, f, None);
-                }
-                let (t00, t10) = self.fetch_pair::<L>(f.top);
-                let (t01, t11) = self.fetch_pair::<L>(f.bottom);
-                let top = lerp15_channels::<L>(t00, t10, f.alpha);
-                return lerp15_channels::<L>(top, lerp15_channels::<L>(t01, t11, f.alpha), f.beta);
-            }
-            LevelTexels::Wrapped(f, right) => (f, right),
+            LevelTexels::Bilinear(f) => (f, None),
+            LevelTexels::Wrapped(f, right) => (f, Some(right)),
         };
-        let (t00, t10) = (self.fetch::<L>(f.top), self.fetch::<L>(f.top + right));
-        let top = lerp15_channels::<L>(t00, t10, f.alpha);
-        let (t01, t11) = (self.fetch::<L>(f.bottom), self.fetch::<L>(f.bottom + right));
-        lerp15_channels::<L>(top, lerp15_channels::<L>(t01, t11, f.alpha), f.beta)
+        let ((t00, t10), (t01, t11)) = match (self, right) {
+            (TexelSource::Linear15(words), None) => {
+                return <L::I32 as TexelGather>::filter15(words, f, None);
+            }
+            (_, None) => (self.fetch_pair::<L>(f.top), self.fetch_pair::<L>(f.bottom)),
+            (_, Some(right)) => (
+                (self.fetch::<L>(f.top), self.fetch::<L>(f.top + right)),
+                (self.fetch::<L>(f.bottom), self.fetch::<L>(f.bottom + right)),
+            ),
+        };
+        bilinear15::<L>([t00, t10, t01, t11], f.alpha, f.beta)
     }
 }
 

@@ -3,7 +3,7 @@
 //! lane gathered, and unpacked to one lane value per channel ([`Channels`]) in the fixed-point
 //! units the sampler filters in, 1/[`LINEAR15_SCALE`](super::texel::LINEAR15_SCALE) (a linear byte `k` is `k · 128`).
 
-use crate::simd::{unpack_words15, I32x8, Lanes, TexelGather};
+use crate::simd::{gather_texel_pair15, unpack_words15, I32x8, Lanes, TexelGather};
 
 /// One lane value per texel channel, in units of 1/[`LINEAR15_SCALE`](super::texel::LINEAR15_SCALE) (0 to 32640).
 pub(super) type Channels<L> = [<L as Lanes>::I32; 4];
@@ -50,10 +50,7 @@ impl TexelSource<'_> {
                     self.unpack_bytes::<L>(second),
                 )
             }
-            TexelSource::Linear15(words) => {
-                let [rg0, ba0, rg1, ba1] = (index + index).gather_u32_quad(words);
-                (unpack_words15::<L>(rg0, ba0), unpack_words15::<L>(rg1, ba1))
-            }
+            TexelSource::Linear15(words) => gather_texel_pair15::<L>(words, index),
         }
     }
 

@@ -100,7 +100,8 @@ pub use scalar::{Scalar, ScalarF32, ScalarI32, ScalarMask};
 #[cfg(target_arch = "x86_64")]
 pub use sse2::{Sse2, Sse41, SseF32, SseI32, SseLevel, SseMask};
 pub use texel_gather::{
-    filter15_reference, lerp15, lerp15_channels, unpack_words15, Footprint15, TexelGather,
+    bilinear15, filter15_reference, gather_texel_pair15, lerp15, lerp15_channels, unpack_words15,
+    Footprint15, TexelGather,
 };
 
 /// The environment variable that forces an instruction set (see [`Isa::from_env`]).

@@ -89,6 +89,24 @@ pub fn unpack_words15<L: Lanes>(rg: L::I32, ba: L::I32) -> [L::I32; 4] {
     ]
 }
 
+/// The texels at texel indices `index` and `index + 1` of a decoded copy (`words`, two per
+/// texel), unpacked: [`TexelGather::gather_u32_quad`] at word `2 · index` (wrapping).
+#[inline(always)]
+pub fn gather_texel_pair15<L: Lanes>(words: &[u32], index: L::I32) -> ([L::I32; 4], [L::I32; 4]) {
+    let [rg0, ba0, rg1, ba1] = (index + index).gather_u32_quad(words);
+    (unpack_words15::<L>(rg0, ba0), unpack_words15::<L>(rg1, ba1))
+}
+
+/// The bilinear blend of a footprint's four texels `[top left, top right, bottom left, bottom
+/// right]`: each row with `alpha`, then the two rows with `beta` ([`lerp15`]).
+#[inline(always)]
+pub fn bilinear15<L: Lanes>(texels: [[L::I32; 4]; 4], alpha: L::I32, beta: L::I32) -> [L::I32; 4] {
+    let [t00, t10, t01, t11] = texels;
+    let top = lerp15_channels::<L>(t00, t10, alpha);
+    let bottom = lerp15_channels::<L>(t01, t11, alpha);
+    lerp15_channels::<L>(top, bottom, beta)
+}
+
 /// [`TexelGather::filter15`], the reference: per level, each row's two texels blended with
 /// `alpha` ([`lerp15`]), then the two rows with `beta`; then, with a second level, the two levels
 /// with its weight (`0..=32767`). The word index of a texel index, `2 · index` (wrapping), is
@@ -113,13 +131,9 @@ pub fn filter15_reference<L: Lanes>(
 /// One level of [`filter15_reference`].
 #[inline(always)]
 fn filter_level15_reference<L: Lanes>(words: &[u32], f: Footprint15<L::I32>) -> [L::I32; 4] {
-    let [rg0, ba0, rg1, ba1] = (f.top + f.top).gather_u32_quad(words);
-    let (t00, t10) = (unpack_words15::<L>(rg0, ba0), unpack_words15::<L>(rg1, ba1));
-    let top = lerp15_channels::<L>(t00, t10, f.alpha);
-    let [rg0, ba0, rg1, ba1] = (f.bottom + f.bottom).gather_u32_quad(words);
-    let (t01, t11) = (unpack_words15::<L>(rg0, ba0), unpack_words15::<L>(rg1, ba1));
-    let bottom = lerp15_channels::<L>(t01, t11, f.alpha);
-    lerp15_channels::<L>(top, bottom, f.beta)
+    let (t00, t10) = gather_texel_pair15::<L>(words, f.top);
+    let (t01, t11) = gather_texel_pair15::<L>(words, f.bottom);
+    bilinear15::<L>([t00, t10, t01, t11], f.alpha, f.beta)
 }
 
 /// [`TexelGather::gather_u32_pair`] (`N = 2`) and [`TexelGather::gather_u32_quad`] (`N = 4`)
