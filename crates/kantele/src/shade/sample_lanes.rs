@@ -27,7 +27,7 @@ use crate::simd::{
 
 use super::texel::{linear15_table, LINEAR15_SCALE};
 use super::texel_lanes::{Channels, TexelSource};
-use super::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
+use super::texture::{ColorSpace, Filter, Linear15Copy, MinFilter, Sampler, Texture, Wrap};
 
 impl Texture {
     /// Samples eight texture coordinates at once, each with the level of detail from its own
@@ -47,15 +47,8 @@ impl Texture {
         active: MaskOf<L>,
     ) -> [L::F32; 4] {
         let pot = self.width().is_power_of_two() && self.height().is_power_of_two();
-        self.sample_grad_lanes_from::<L>(
-            self.lane_texels(),
-            sampler,
-            pot,
-            uv,
-            duv_dx,
-            duv_dy,
-            active,
-        )
+        let (source, layout) = self.lane_texels();
+        self.sample_grad_lanes_from::<L>(source, layout, sampler, pot, uv, duv_dx, duv_dy, active)
     }
 
     /// This texture and `sampler` as a [`TrilinearRepeat15`] when they are that configuration
@@ -65,20 +58,28 @@ impl Texture {
             && self.width().is_power_of_two()
             && self.height().is_power_of_two()
             && self.color_space == ColorSpace::Srgb;
-        let words = self.linear15().filter(|_| configuration)?;
+        let copy = self.linear15().filter(|_| configuration)?;
         Some(TrilinearRepeat15 {
             texture: self,
-            words,
+            copy,
         })
     }
 
-    /// Where [`Texture::sample_grad_lanes`] reads the texels: the decoded copy of an sRGB
-    /// texture when it has one ([`Texture::linear15`]), otherwise the bytes.
-    fn lane_texels(&self) -> TexelSource<'_> {
+    /// Where [`Texture::sample_grad_lanes`] reads the texels, and how they are laid out: the
+    /// decoded copy of an sRGB texture when it has one ([`Texture::linear15`]), otherwise the
+    /// bytes.
+    fn lane_texels(&self) -> (TexelSource<'_>, LevelLayout<'_>) {
+        let bytes = LevelLayout {
+            offsets: &self.levels.offsets,
+            row_padding: 0,
+        };
         match (self.color_space, self.linear15()) {
-            (ColorSpace::Linear, _) => TexelSource::LinearBytes(&self.texels),
-            (ColorSpace::Srgb, Some(words)) => TexelSource::Linear15(words),
-            (ColorSpace::Srgb, None) => TexelSource::SrgbBytes(&self.texels, linear15_table()),
+            (ColorSpace::Linear, _) => (TexelSource::LinearBytes(&self.texels), bytes),
+            (ColorSpace::Srgb, Some(copy)) => (TexelSource::Linear15(&copy.words), copy.layout()),
+            (ColorSpace::Srgb, None) => (
+                TexelSource::SrgbBytes(&self.texels, linear15_table()),
+                bytes,
+            ),
         }
     }
 
@@ -89,6 +90,7 @@ impl Texture {
     fn sample_grad_lanes_from<L: Lanes>(
         &self,
         source: TexelSource<'_>,
+        layout: LevelLayout<'_>,
         sampler: &Sampler,
         pot: bool,
         uv: [L::F32; 2],
@@ -122,11 +124,13 @@ impl Texture {
             LevelSelection::<L>::new(self, sampler, self.lod_lanes::<L>(rho2))
         };
         let nearest = selection.nearest;
-        let first = self.level_texels::<L>(sampler, pot, selection.first, uv, nearest, live);
+        let first =
+            self.level_texels::<L>(layout, sampler, pot, selection.first, uv, nearest, live);
         // The second level only where some live lane blends (trilinear between levels).
         let blend = selection.fraction.simd_gt(zero).and(live);
         let texel = if blend.any() {
-            let second = self.level_texels::<L>(sampler, pot, selection.second, uv, nearest, live);
+            let second =
+                self.level_texels::<L>(layout, sampler, pot, selection.second, uv, nearest, live);
             // A lane with fraction 0 keeps `first` exactly (`lerp15` with weight 0).
             let fraction = weight15::<L>(selection.fraction);
             match (source, &first, &second) {
@@ -188,12 +192,15 @@ impl Texture {
         normal.select_f32(lod, fallback)
     }
 
-    /// The texels one level per lane reads (`level` holds each lane's level index) at `uv`, and
-    /// their weights: nearest where `nearest` is set and bilinear elsewhere; lanes outside `live`
-    /// are unspecified; `pot` as in [`Texture::sample_grad_lanes_from`].
+    /// The texels one level per lane reads (`level` holds each lane's level index) at `uv`, as
+    /// indices into a source laid out as `layout`, and their weights: nearest where `nearest` is
+    /// set and bilinear elsewhere; lanes outside `live` are unspecified; `pot` as in
+    /// [`Texture::sample_grad_lanes_from`].
     #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
     fn level_texels<L: Lanes>(
         &self,
+        layout: LevelLayout<'_>,
         sampler: &Sampler,
         pot: bool,
         level: L::I32,
@@ -202,7 +209,8 @@ impl Texture {
         live: MaskOf<L>,
     ) -> LevelTexels<L> {
         let lanes = nearest.lanes();
-        let (offset, width, height) = self.level_extents::<L>(level, live);
+        let (offset, width, height) = self.level_extents::<L>(layout, level, live);
+        let row_length = width + lanes.splat_i32(layout.row_padding);
         let s = LaneAxis::<L>::new(sampler.wrap_s, uv[0], width);
         let t = LaneAxis::<L>::new(sampler.wrap_t, uv[1], height);
         if nearest.all() {
@@ -212,7 +220,7 @@ impl Texture {
             let j = sampler
                 .wrap_t
                 .wrap_lanes::<L>(t.coord.to_i32_floor(), height, pot);
-            return LevelTexels::Nearest(offset + j * width + i);
+            return LevelTexels::Nearest(offset + j * row_length + i);
         }
         // Bilinear: texel centres at integer + ½. Each coordinate is rounded once to 1/32768 of
         // a texel: the whole texels are its left (top) texel, the fraction its weight in the
@@ -224,11 +232,14 @@ impl Texture {
         let one = lanes.splat_i32(1);
         let x0 = sampler.wrap_s.wrap_lanes::<L>(i0, width, pot);
         let x1 = sampler.wrap_s.wrap_lanes::<L>(i0 + one, width, pot);
-        let row0 = offset + sampler.wrap_t.wrap_lanes::<L>(j0, height, pot) * width;
-        let row1 = offset + sampler.wrap_t.wrap_lanes::<L>(j0 + one, height, pot) * width;
-        // Where every live lane's two columns are neighbours in memory (no wrap between them,
-        // the common case), each row's pair of texels is one read per lane.
-        let neighbours = x1.simd_eq(x0 + one).or(live.not()).all();
+        let row0 = offset + sampler.wrap_t.wrap_lanes::<L>(j0, height, pot) * row_length;
+        let row1 = offset + sampler.wrap_t.wrap_lanes::<L>(j0 + one, height, pot) * row_length;
+        // Where every live lane's two columns are neighbours in memory, each row's pair of
+        // texels is one read per lane: always under REPEAT in a layout whose rows repeat their
+        // first texel at the end (the texel after column `width − 1` is column 0, as REPEAT
+        // wraps it), else where no live lane's columns wrap between them (the common case).
+        let neighbours = (layout.row_padding == 1 && sampler.wrap_s == Wrap::Repeat)
+            || x1.simd_eq(x0 + one).or(live.not()).all();
         let footprint = Footprint15 {
             top: row0 + x0,
             bottom: row1 + x0,
@@ -243,10 +254,15 @@ impl Texture {
         }
     }
 
-    /// Each lane's level offset, width and height from the level table: one splat when every
-    /// `live` lane reads the same level (the common case), else gathered per lane.
+    /// Each lane's level offset (in `layout`), width and height: one splat when every `live`
+    /// lane reads the same level (the common case), else gathered per lane.
     #[inline(always)]
-    fn level_extents<L: Lanes>(&self, level: L::I32, live: MaskOf<L>) -> (L::I32, L::I32, L::I32) {
+    fn level_extents<L: Lanes>(
+        &self,
+        layout: LevelLayout<'_>,
+        level: L::I32,
+        live: MaskOf<L>,
+    ) -> (L::I32, L::I32, L::I32) {
         let lanes = live.lanes();
         let first_live = (live.bits().trailing_zeros() as usize).min(7);
         let first_level = level.extract(first_live);
@@ -256,13 +272,13 @@ impl Texture {
             .all();
         let table = &self.levels;
         match usize::try_from(first_level) {
-            Ok(index) if same && index < table.offsets.len() => (
-                lanes.splat_i32(table.offsets[index] as i32),
+            Ok(index) if same && index < layout.offsets.len() => (
+                lanes.splat_i32(layout.offsets[index] as i32),
                 lanes.splat_i32(table.widths[index] as i32),
                 lanes.splat_i32(table.heights[index] as i32),
             ),
             _ => (
-                level.gather_u32(&table.offsets),
+                level.gather_u32(layout.offsets),
                 level.gather_u32(&table.widths),
                 level.gather_u32(&table.heights),
             ),
@@ -279,7 +295,7 @@ impl Texture {
 pub(crate) struct TrilinearRepeat15<'t> {
     texture: &'t Texture,
     /// The texture's decoded copy ([`Texture::linear15`]).
-    words: &'t [u32],
+    copy: &'t Linear15Copy,
 }
 
 impl TrilinearRepeat15<'_> {
@@ -301,7 +317,8 @@ impl TrilinearRepeat15<'_> {
         active: MaskOf<L>,
     ) -> [L::F32; 4] {
         self.texture.sample_grad_lanes_from::<L>(
-            TexelSource::Linear15(self.words),
+            TexelSource::Linear15(&self.copy.words),
+            self.copy.layout(),
             &Self::SAMPLER,
             true,
             uv,
@@ -309,6 +326,27 @@ impl TrilinearRepeat15<'_> {
             duv_dy,
             active,
         )
+    }
+}
+
+/// Where a texel source holds each level: the index of its first texel, and rows of `width +
+/// row_padding` texels.
+#[derive(Clone, Copy)]
+struct LevelLayout<'t> {
+    /// Index of each level's first texel, level 0 first.
+    offsets: &'t [u32],
+    /// 0 (the texel storage), or 1 (a [`Linear15Copy`]: each row ends with a copy of its first
+    /// texel).
+    row_padding: i32,
+}
+
+impl Linear15Copy {
+    /// This copy's layout.
+    fn layout(&self) -> LevelLayout<'_> {
+        LevelLayout {
+            offsets: &self.offsets,
+            row_padding: 1,
+        }
     }
 }
 
@@ -563,6 +601,7 @@ pub(super) fn log2_normal<L: Lanes>(x: L::F32) -> L::F32 {
 
 #[cfg(test)]
 mod tests {
+    use crate::shade::texel::srgb_texel_to_linear15;
     use glam::{Vec2, Vec4};
 
     use super::*;
@@ -596,15 +635,20 @@ mod tests {
                     lanes.f32_from_array(v.map(|p| p.y)),
                 ]
             };
-            let source = match self.texture.lane_texels() {
-                TexelSource::Linear15(_) if self.bytes => {
-                    TexelSource::SrgbBytes(&self.texture.texels, linear15_table())
-                }
-                source => source,
+            let (source, layout) = match self.texture.lane_texels() {
+                (TexelSource::Linear15(_), _) if self.bytes => (
+                    TexelSource::SrgbBytes(&self.texture.texels, linear15_table()),
+                    LevelLayout {
+                        offsets: &self.texture.levels.offsets,
+                        row_padding: 0,
+                    },
+                ),
+                texels => texels,
             };
             self.texture
                 .sample_grad_lanes_from::<L>(
                     source,
+                    layout,
                     &self.sampler,
                     self.texture.width().is_power_of_two()
                         && self.texture.height().is_power_of_two(),
@@ -831,7 +875,7 @@ mod tests {
             noise_texture(16, 8, ColorSpace::Srgb),
             noise_texture(7, 5, ColorSpace::Srgb),
         ] {
-            assert!(matches!(texture.lane_texels(), TexelSource::Linear15(_)));
+            assert!(matches!(texture.lane_texels().0, TexelSource::Linear15(_)));
             for sampler in samplers() {
                 for query in queries(&mut rng, 6) {
                     let kernel = |bytes| Sample {
@@ -856,24 +900,41 @@ mod tests {
         }
     }
 
-    /// Only sRGB textures up to 2048 × 2048 keep a decoded copy (8 bytes a texel).
+    /// Only sRGB textures up to 2048 × 2048 keep a decoded copy (8 bytes a texel, rows one
+    /// texel longer), and its every row ends with its first texel again.
     #[test]
     fn decoded_copy_is_kept_for_small_srgb_textures_only() {
         let srgb = noise_texture(4, 4, ColorSpace::Srgb);
         let before = srgb.memory_bytes();
         srgb.prepare_lane_sampling();
+        let copy = srgb.linear15().expect("a decoded copy");
+        let padded: usize = srgb
+            .levels()
+            .map(|l| (l.width as usize + 1) * l.height as usize)
+            .sum();
+        assert_eq!(copy.words.len(), 2 * padded);
         assert_eq!(
-            srgb.linear15().map(<[u32]>::len),
-            Some(2 * srgb.texels.len())
+            srgb.memory_bytes() - before,
+            4 * (2 * padded + srgb.level_count())
         );
-        assert_eq!(srgb.memory_bytes() - before, 8 * srgb.texels.len());
+        for (level, &offset) in srgb.levels().zip(&copy.offsets) {
+            let row_length = level.width as usize + 1;
+            for y in 0..level.height {
+                let row = 2 * (offset as usize + y as usize * row_length);
+                let word = |x: usize| &copy.words[row + 2 * x..][..2];
+                for x in 0..level.width {
+                    assert_eq!(word(x as usize), srgb_texel_to_linear15(level.packed(x, y)));
+                }
+                assert_eq!(word(level.width as usize), word(0));
+            }
+        }
         let linear = noise_texture(4, 4, ColorSpace::Linear);
         linear.prepare_lane_sampling();
         assert!(linear.linear15().is_none());
         let wide = Texture::from_rgba8(4097, 1024, &vec![7; 4097 * 1024 * 4], ColorSpace::Srgb)
             .expect("texture");
         assert!(wide.linear15().is_none());
-        assert!(matches!(wide.lane_texels(), TexelSource::SrgbBytes(..)));
+        assert!(matches!(wide.lane_texels().0, TexelSource::SrgbBytes(..)));
     }
 
     #[test]

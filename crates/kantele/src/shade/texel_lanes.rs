@@ -17,8 +17,9 @@ pub(super) enum TexelSource<'t> {
     /// fixed-point linear values ([`linear15_table`](super::texel::linear15_table)), alpha as
     /// `a · 128`.
     SrgbBytes(&'t [u32], &'t [u32; 256]),
-    /// An sRGB texture's decoded copy: two words per texel, `[r | g << 16, b | a << 16]`, the same
-    /// values as `SrgbBytes` gives.
+    /// An sRGB texture's decoded copy ([`Linear15Copy`](super::texture::Linear15Copy)): two
+    /// words per texel, `[r | g << 16, b | a << 16]`, the same values as `SrgbBytes` gives, in
+    /// rows one texel longer than the level's.
     Linear15(&'t [u32]),
 }
 

@@ -92,10 +92,53 @@ pub struct Texture {
     pub(super) texels: Vec<u32>,
     pub(super) levels: LevelTable,
     pub(super) color_space: ColorSpace,
-    /// An sRGB texture's texels decoded to 15-bit linear units, 16 bits per channel, two words per texel
-    /// ([`srgb_texel_to_linear15`]), same layout as `texels`: built on first use by the lane-wide
-    /// sampler, for textures up to [`LINEAR15_MAX_TEXELS`] (see [`Texture::linear15`]).
-    linear15: OnceLock<Vec<u32>>,
+    /// An sRGB texture's texels decoded to 15-bit linear units ([`Linear15Copy`]): built on first
+    /// use by the lane-wide sampler, for textures up to [`LINEAR15_MAX_TEXELS`] (see
+    /// [`Texture::linear15`]).
+    linear15: OnceLock<Linear15Copy>,
+}
+
+/// An sRGB texture's texels decoded for the lane-wide sampler: 16 bits per channel, two words
+/// per texel (`[r | g << 16, b | a << 16]`, [`srgb_texel_to_linear15`]), level by level and row
+/// by row as in the texel storage, but every row one texel longer: its last texel repeats the
+/// row's first. A bilinear footprint whose right column wraps around to column 0 (REPEAT) then
+/// still finds its row's two texels side by side in memory, one read per lane like every other
+/// footprint. Row `y` of level `l` starts at texel `offsets[l] + y · (width_l + 1)`.
+#[derive(Clone, Debug)]
+pub(super) struct Linear15Copy {
+    /// The decoded texels, two words each.
+    pub(super) words: Vec<u32>,
+    /// Index (in texels, half the word index) of each level's first texel, level 0 first.
+    pub(super) offsets: Vec<u32>,
+}
+
+impl Linear15Copy {
+    /// The copy of `texels`, laid out as `levels` describes.
+    fn new(texels: &[u32], levels: &LevelTable) -> Self {
+        let padded: usize = (levels.widths.iter())
+            .zip(&levels.heights)
+            .map(|(&w, &h)| (w as usize + 1) * h as usize)
+            .sum();
+        let mut words = Vec::with_capacity(2 * padded);
+        let mut offsets = Vec::with_capacity(levels.offsets.len());
+        for ((&offset, &width), &height) in levels
+            .offsets
+            .iter()
+            .zip(&levels.widths)
+            .zip(&levels.heights)
+        {
+            // At most (16384 + 1) · 16384 · 4/3 texels: fits in u32 (and i32, for the gathers).
+            offsets.push((words.len() / 2) as u32);
+            let level = &texels[offset as usize..][..width as usize * height as usize];
+            for row in level.chunks_exact(width as usize) {
+                for &texel in row.iter().chain(&row[..1]) {
+                    words.extend(srgb_texel_to_linear15(texel));
+                }
+            }
+        }
+        debug_assert_eq!(words.len(), 2 * padded);
+        Self { words, offsets }
+    }
 }
 
 impl std::fmt::Debug for Texture {
@@ -195,18 +238,15 @@ impl Texture {
     /// The texels decoded to 15-bit linear units (two words per texel, [`srgb_texel_to_linear15`]) for an
     /// sRGB texture whose level 0 holds at most [`LINEAR15_MAX_TEXELS`] texels, built on first
     /// use; `None` for linear and larger textures.
-    pub(super) fn linear15(&self) -> Option<&[u32]> {
+    pub(super) fn linear15(&self) -> Option<&Linear15Copy> {
         let small = self.width() as usize * self.height() as usize <= LINEAR15_MAX_TEXELS;
         if self.color_space != ColorSpace::Srgb || !small {
             return None;
         }
-        let words = self.linear15.get_or_init(|| {
-            self.texels
-                .iter()
-                .flat_map(|&t| srgb_texel_to_linear15(t))
-                .collect()
-        });
-        Some(words)
+        Some(
+            self.linear15
+                .get_or_init(|| Linear15Copy::new(&self.texels, &self.levels)),
+        )
     }
 
     /// Width of level 0 in texels.
@@ -250,7 +290,10 @@ impl Texture {
     /// Bytes of memory the texture holds: the texels of every level, the level table and, once
     /// built, the lane-wide sampler's decoded copy ([`Texture::prepare_lane_sampling`]).
     pub fn memory_bytes(&self) -> usize {
-        let decoded = self.linear15.get().map_or(0, Vec::capacity);
+        let decoded = self
+            .linear15
+            .get()
+            .map_or(0, |copy| copy.words.capacity() + copy.offsets.capacity());
         std::mem::size_of::<Self>()
             + (self.texels.capacity() + decoded) * std::mem::size_of::<u32>()
             + 3 * self.levels.offsets.capacity() * std::mem::size_of::<u32>()
