@@ -47,8 +47,15 @@ impl Texture {
         active: MaskOf<L>,
     ) -> [L::F32; 4] {
         let pot = self.width().is_power_of_two() && self.height().is_power_of_two();
-        let (source, layout) = self.lane_texels();
-        self.sample_grad_lanes_from::<L>(source, layout, sampler, pot, uv, duv_dx, duv_dy, active)
+        self.sample_grad_lanes_from::<L>(
+            self.lane_texels(),
+            sampler,
+            pot,
+            uv,
+            duv_dx,
+            duv_dy,
+            active,
+        )
     }
 
     /// This texture and `sampler` as a [`TrilinearRepeat15`] when they are that configuration
@@ -65,21 +72,28 @@ impl Texture {
         })
     }
 
-    /// Where [`Texture::sample_grad_lanes`] reads the texels, and how they are laid out: the
-    /// decoded copy of an sRGB texture when it has one ([`Texture::linear15`]), otherwise the
-    /// bytes.
-    fn lane_texels(&self) -> (TexelSource<'_>, LevelLayout<'_>) {
-        let bytes = LevelLayout {
-            offsets: &self.levels.offsets,
-            row_padding: 0,
-        };
+    /// Where [`Texture::sample_grad_lanes`] reads the texels: the decoded copy of an sRGB
+    /// texture when it has one ([`Texture::linear15`]), otherwise the bytes.
+    fn lane_texels(&self) -> TexelSource<'_> {
         match (self.color_space, self.linear15()) {
-            (ColorSpace::Linear, _) => (TexelSource::LinearBytes(&self.texels), bytes),
-            (ColorSpace::Srgb, Some(copy)) => (TexelSource::Linear15(&copy.words), copy.layout()),
-            (ColorSpace::Srgb, None) => (
-                TexelSource::SrgbBytes(&self.texels, linear15_table()),
-                bytes,
-            ),
+            (ColorSpace::Linear, _) => TexelSource::LinearBytes(&self.texels),
+            (ColorSpace::Srgb, Some(copy)) => TexelSource::Linear15(copy),
+            (ColorSpace::Srgb, None) => TexelSource::SrgbBytes(&self.texels, linear15_table()),
+        }
+    }
+
+    /// How `source`, one of this texture's texel sources, lays out the levels.
+    #[inline(always)]
+    fn level_layout<'t>(&'t self, source: TexelSource<'t>) -> LevelLayout<'t> {
+        match source {
+            TexelSource::Linear15(copy) => LevelLayout {
+                offsets: &copy.offsets,
+                row_padding: 1,
+            },
+            TexelSource::LinearBytes(_) | TexelSource::SrgbBytes(..) => LevelLayout {
+                offsets: &self.levels.offsets,
+                row_padding: 0,
+            },
         }
     }
 
@@ -90,7 +104,6 @@ impl Texture {
     fn sample_grad_lanes_from<L: Lanes>(
         &self,
         source: TexelSource<'_>,
-        layout: LevelLayout<'_>,
         sampler: &Sampler,
         pot: bool,
         uv: [L::F32; 2],
@@ -124,6 +137,7 @@ impl Texture {
             LevelSelection::<L>::new(self, sampler, self.lod_lanes::<L>(rho2))
         };
         let nearest = selection.nearest;
+        let layout = self.level_layout(source);
         let first =
             self.level_texels::<L>(layout, sampler, pot, selection.first, uv, nearest, live);
         // The second level only where some live lane blends (trilinear between levels).
@@ -135,10 +149,10 @@ impl Texture {
             let fraction = weight15::<L>(selection.fraction);
             match (source, &first, &second) {
                 (
-                    TexelSource::Linear15(words),
+                    TexelSource::Linear15(copy),
                     LevelTexels::Bilinear(f0),
                     LevelTexels::Bilinear(f1),
-                ) => <L::I32 as TexelGather>::filter15(words, *f0, Some((*f1, fraction))),
+                ) => <L::I32 as TexelGather>::filter15(&copy.words, *f0, Some((*f1, fraction))),
                 _ => lerp15_channels::<L>(
                     source.filter::<L>(&first),
                     source.filter::<L>(&second),
@@ -317,8 +331,7 @@ impl TrilinearRepeat15<'_> {
         active: MaskOf<L>,
     ) -> [L::F32; 4] {
         self.texture.sample_grad_lanes_from::<L>(
-            TexelSource::Linear15(&self.copy.words),
-            self.copy.layout(),
+            TexelSource::Linear15(self.copy),
             &Self::SAMPLER,
             true,
             uv,
@@ -338,16 +351,6 @@ struct LevelLayout<'t> {
     /// 0 (the texel storage), or 1 (a [`Linear15Copy`]: each row ends with a copy of its first
     /// texel).
     row_padding: i32,
-}
-
-impl Linear15Copy {
-    /// This copy's layout.
-    fn layout(&self) -> LevelLayout<'_> {
-        LevelLayout {
-            offsets: &self.offsets,
-            row_padding: 1,
-        }
-    }
 }
 
 /// `w ∈ [0, 1]` in the filter's units of 1/32768, rounded to the nearest and clamped to
@@ -407,8 +410,8 @@ impl TexelSource<'_> {
             LevelTexels::Wrapped(f, right) => (f, Some(right)),
         };
         let ((t00, t10), (t01, t11)) = match (self, right) {
-            (TexelSource::Linear15(words), None) => {
-                return <L::I32 as TexelGather>::filter15(words, f, None);
+            (TexelSource::Linear15(copy), None) => {
+                return <L::I32 as TexelGather>::filter15(&copy.words, f, None);
             }
             (_, None) => (self.fetch_pair::<L>(f.top), self.fetch_pair::<L>(f.bottom)),
             (_, Some(right)) => (
@@ -635,20 +638,15 @@ mod tests {
                     lanes.f32_from_array(v.map(|p| p.y)),
                 ]
             };
-            let (source, layout) = match self.texture.lane_texels() {
-                (TexelSource::Linear15(_), _) if self.bytes => (
-                    TexelSource::SrgbBytes(&self.texture.texels, linear15_table()),
-                    LevelLayout {
-                        offsets: &self.texture.levels.offsets,
-                        row_padding: 0,
-                    },
-                ),
-                texels => texels,
+            let source = match self.texture.lane_texels() {
+                TexelSource::Linear15(_) if self.bytes => {
+                    TexelSource::SrgbBytes(&self.texture.texels, linear15_table())
+                }
+                source => source,
             };
             self.texture
                 .sample_grad_lanes_from::<L>(
                     source,
-                    layout,
                     &self.sampler,
                     self.texture.width().is_power_of_two()
                         && self.texture.height().is_power_of_two(),
@@ -875,7 +873,7 @@ mod tests {
             noise_texture(16, 8, ColorSpace::Srgb),
             noise_texture(7, 5, ColorSpace::Srgb),
         ] {
-            assert!(matches!(texture.lane_texels().0, TexelSource::Linear15(_)));
+            assert!(matches!(texture.lane_texels(), TexelSource::Linear15(_)));
             for sampler in samplers() {
                 for query in queries(&mut rng, 6) {
                     let kernel = |bytes| Sample {
@@ -934,7 +932,7 @@ mod tests {
         let wide = Texture::from_rgba8(4097, 1024, &vec![7; 4097 * 1024 * 4], ColorSpace::Srgb)
             .expect("texture");
         assert!(wide.linear15().is_none());
-        assert!(matches!(wide.lane_texels().0, TexelSource::SrgbBytes(..)));
+        assert!(matches!(wide.lane_texels(), TexelSource::SrgbBytes(..)));
     }
 
     #[test]

@@ -3,6 +3,7 @@
 //! lane gathered, and unpacked to one lane value per channel ([`Channels`]) in the fixed-point
 //! units the sampler filters in, 1/[`LINEAR15_SCALE`](super::texel::LINEAR15_SCALE) (a linear byte `k` is `k · 128`).
 
+use super::texture::Linear15Copy;
 use crate::simd::{gather_texel_pair15, unpack_words15, I32x8, Lanes, TexelGather};
 
 /// One lane value per texel channel, in units of 1/[`LINEAR15_SCALE`](super::texel::LINEAR15_SCALE) (0 to 32640).
@@ -17,10 +18,10 @@ pub(super) enum TexelSource<'t> {
     /// fixed-point linear values ([`linear15_table`](super::texel::linear15_table)), alpha as
     /// `a · 128`.
     SrgbBytes(&'t [u32], &'t [u32; 256]),
-    /// An sRGB texture's decoded copy ([`Linear15Copy`](super::texture::Linear15Copy)): two
-    /// words per texel, `[r | g << 16, b | a << 16]`, the same values as `SrgbBytes` gives, in
-    /// rows one texel longer than the level's.
-    Linear15(&'t [u32]),
+    /// An sRGB texture's decoded copy ([`Linear15Copy`]): two words per texel,
+    /// `[r | g << 16, b | a << 16]`, the same values as `SrgbBytes` gives, in rows one texel
+    /// longer than the level's.
+    Linear15(&'t Linear15Copy),
 }
 
 impl TexelSource<'_> {
@@ -31,8 +32,8 @@ impl TexelSource<'_> {
             TexelSource::LinearBytes(texels) | TexelSource::SrgbBytes(texels, _) => {
                 self.unpack_bytes::<L>(index.gather_u32(texels))
             }
-            TexelSource::Linear15(words) => {
-                let (rg, ba) = (index + index).gather_u32_pair(words);
+            TexelSource::Linear15(copy) => {
+                let (rg, ba) = (index + index).gather_u32_pair(&copy.words);
                 unpack_words15::<L>(rg, ba)
             }
         }
@@ -51,7 +52,7 @@ impl TexelSource<'_> {
                     self.unpack_bytes::<L>(second),
                 )
             }
-            TexelSource::Linear15(words) => gather_texel_pair15::<L>(words, index),
+            TexelSource::Linear15(copy) => gather_texel_pair15::<L>(&copy.words, index),
         }
     }
 

@@ -113,24 +113,17 @@ pub(super) struct Linear15Copy {
 }
 
 impl Linear15Copy {
-    /// The copy of `texels`, laid out as `levels` describes.
-    fn new(texels: &[u32], levels: &LevelTable) -> Self {
-        let padded: usize = (levels.widths.iter())
-            .zip(&levels.heights)
-            .map(|(&w, &h)| (w as usize + 1) * h as usize)
+    /// The copy of `texture`'s mip chain.
+    fn new(texture: &Texture) -> Self {
+        let padded: usize = (texture.levels())
+            .map(|l| (l.width as usize + 1) * l.height as usize)
             .sum();
         let mut words = Vec::with_capacity(2 * padded);
-        let mut offsets = Vec::with_capacity(levels.offsets.len());
-        for ((&offset, &width), &height) in levels
-            .offsets
-            .iter()
-            .zip(&levels.widths)
-            .zip(&levels.heights)
-        {
+        let mut offsets = Vec::with_capacity(texture.level_count());
+        for level in texture.levels() {
             // At most (16384 + 1) · 16384 · 4/3 texels: fits in u32 (and i32, for the gathers).
             offsets.push((words.len() / 2) as u32);
-            let level = &texels[offset as usize..][..width as usize * height as usize];
-            for row in level.chunks_exact(width as usize) {
+            for row in level.texels.chunks_exact(level.width as usize) {
                 for &texel in row.iter().chain(&row[..1]) {
                     words.extend(srgb_texel_to_linear15(texel));
                 }
@@ -243,10 +236,7 @@ impl Texture {
         if self.color_space != ColorSpace::Srgb || !small {
             return None;
         }
-        Some(
-            self.linear15
-                .get_or_init(|| Linear15Copy::new(&self.texels, &self.levels)),
-        )
+        Some(self.linear15.get_or_init(|| Linear15Copy::new(self)))
     }
 
     /// Width of level 0 in texels.
