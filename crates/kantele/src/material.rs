@@ -386,6 +386,10 @@ impl<const UNLIT: bool, const VERTEX_COLORS: bool> LaneProgram
     /// makes these the largest kernels: compiled once.
     const CONSTANT_KERNELS: bool = false;
 
+    /// Each lane is shaded from its own values, and the sampler's results do not depend on
+    /// which lanes share a call (see `sample_grad_lanes`).
+    const PACKED_ROWS: bool = true;
+
     #[inline(always)]
     fn fragment_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
         let (shader, lanes) = (self.shader, f.lanes);
