@@ -78,11 +78,12 @@ pub(super) fn raster_tiles(
         .tiles_mut()
         .par_iter_mut()
         .enumerate()
-        .map(|(tile_index, tile)| {
+        // The storage for packed rows is made once per piece of work rayon splits off, not
+        // once per tile.
+        .map_init(PackedRows::new, |packed, (tile_index, tile)| {
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();
             let mut coverage = BlockCoverage::default();
-            let mut packed = PackedRows::new();
             for (k, t) in binned_triangles(bins, geometry, tile_index) {
                 // Budget: every few triangles (robust branch).
                 if k % TRIANGLES_PER_CHECK == 0 && budget.exhausted() {
@@ -106,7 +107,7 @@ pub(super) fn raster_tiles(
                 let attrs = geometry.attrs(t);
                 // No `materialize`: the per-pixel path writes each block's pending clear
                 // together with the first triangle that reaches the block.
-                let c = draw.raster(tri, attrs, &coverage, &mut packed, tile, isa);
+                let c = draw.raster(tri, attrs, &coverage, packed, tile, isa);
                 counters = RasterCounters::sum(counters, c);
             }
             counters
