@@ -386,6 +386,10 @@ impl<const UNLIT: bool, const VERTEX_COLORS: bool> LaneProgram
     /// makes these the largest kernels: compiled once.
     const CONSTANT_KERNELS: bool = false;
 
+    /// Each lane is shaded from its own values, and the sampler's results do not depend on
+    /// which lanes share a call (see `sample_grad_lanes`).
+    const PACKED_ROWS: bool = true;
+
     #[inline(always)]
     fn fragment_lanes<L: Lanes>(&self, f: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
         let (shader, lanes) = (self.shader, f.lanes);
@@ -877,6 +881,87 @@ mod tests {
 
     /// Every specialised lane program (untextured and textured, lit and unlit, with and without
     /// vertex colours) gives the bits of the general program it replaces, on a receding quad
+    /// Small triangles (a jittered grid of cells about 3 × 3 pixels, each two triangles) leave
+    /// most rows of their blocks nearly empty, so the textured program's kernel shades them
+    /// packed ([`LaneProgram::PACKED_ROWS`]); the general program is never packed. Both give
+    /// the same bits, on every instruction set.
+    #[test]
+    fn packed_rows_shade_as_rows_do() {
+        let rgba: Vec<u8> = (0..32u32 * 32)
+            .flat_map(|i| {
+                let (x, y) = (i % 32, i / 32);
+                [(x * 8) as u8, (y * 8) as u8, ((x ^ y) * 8) as u8, 255]
+            })
+            .collect();
+        let texture = Texture::from_rgba8(32, 32, &rgba, ColorSpace::Srgb).expect("texture");
+        texture.prepare_lane_sampling();
+        let (columns, rows) = (32u32, 21u32);
+        let mut jitter = 0x2545_f491u32;
+        let mut next = move || {
+            jitter ^= jitter << 13;
+            jitter ^= jitter >> 17;
+            jitter ^= jitter << 5;
+            (jitter % 1000) as f32 / 1000.0 - 0.5
+        };
+        let mut mesh = Mesh {
+            positions: Vec::new(),
+            normals: Some(Vec::new()),
+            texcoords: Some(Vec::new()),
+            ..Mesh::default()
+        };
+        for j in 0..=rows {
+            for i in 0..=columns {
+                let (u, v) = (i as f32 / columns as f32, j as f32 / rows as f32);
+                let x = -1.0 + 2.0 * u + 0.02 * next();
+                let y = -1.0 + 2.0 * v + 0.02 * next();
+                mesh.positions.push(Vec3::new(x, y, 0.5 + 0.3 * next()));
+                let normal = Vec3::new(next(), next(), 1.0).normalize();
+                mesh.normals.as_mut().unwrap().push(normal);
+                mesh.texcoords
+                    .as_mut()
+                    .unwrap()
+                    .push(Vec2::new(3.0 * u, 5.0 * v * v));
+            }
+        }
+        for j in 0..rows {
+            for i in 0..columns {
+                let at = j * (columns + 1) + i;
+                let (right, up) = (at + 1, at + columns + 1);
+                mesh.indices.extend([at, right, up + 1, at, up + 1, up]);
+            }
+        }
+        let lighting = Lighting {
+            to_light: Vec3::new(0.3, 0.4, 0.8).normalize(),
+            light_color: Vec3::ONE,
+            ambient: 0.2,
+        };
+        let material = Material::default();
+        let shader = MaterialShader::new(
+            Mat4::IDENTITY,
+            Mat4::IDENTITY,
+            lighting,
+            &material,
+            Some((&texture, TrilinearRepeat15::SAMPLER)),
+            Pass::Color,
+            (1, 1),
+        );
+        assert!(shader.opaque_textured().is_some());
+        for isa in Isa::supported() {
+            let options = RendererOptions {
+                isa: Some(isa),
+                ..RendererOptions::default()
+            };
+            let packed = render_with(&shader, &mesh, options);
+            let rows = render_with(&GeneralProgram(&shader), &mesh, options);
+            let drawn = packed
+                .chunks_exact(4)
+                .filter(|c| c[2] != 0.3f32.to_bits())
+                .count();
+            assert!(drawn > 5000, "{isa}: {drawn} pixels drawn");
+            assert!(packed == rows, "{isa}: packed rows differ from rows");
+        }
+    }
+
     /// whose texture is magnified near the camera and minified (trilinear, repeating) far away.
     #[test]
     fn specialised_lane_programs_shade_as_the_general_one() {

@@ -6,6 +6,7 @@ use glam::Vec4;
 use super::fragment::{shade_triangle, RasterCounters};
 use super::geometry::{PrimitiveBatch, ShadedVertices, TargetSpace};
 use super::multisample::shade_triangle_multisampled;
+use super::packed_rows::PackedRows;
 use super::shader::Shader;
 use crate::geometry::clip::{classify_codes, ClipCode, ClipPolygon, ClipTest, ClipVertex};
 use crate::raster::samples::SampleCoverage;
@@ -68,12 +69,14 @@ pub(super) trait DrawJob: Sync {
         target: &TargetSpace,
         out: &mut PrimitiveBatch,
     );
-    /// Shades the triangle's pixels in `coverage` into one tile.
+    /// Shades the triangle's pixels in `coverage` into one tile (`packed`: the tile's storage
+    /// for packed rows).
     fn raster(
         &self,
         tri: &TriangleSetup,
         attrs: &[f32],
         coverage: &BlockCoverage,
+        packed: &mut PackedRows,
         tile: &mut TileBuffer,
         isa: Isa,
     ) -> RasterCounters;
@@ -251,10 +254,11 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
         tri: &TriangleSetup,
         attrs: &[f32],
         coverage: &BlockCoverage,
+        packed: &mut PackedRows,
         tile: &mut TileBuffer,
         isa: Isa,
     ) -> RasterCounters {
-        shade_triangle(self, tri, attrs, coverage, tile, isa)
+        shade_triangle(self, tri, attrs, coverage, packed, tile, isa)
     }
 
     fn raster_multisampled(

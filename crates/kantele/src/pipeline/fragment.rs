@@ -22,7 +22,10 @@ use crate::raster::bin::{TileBins, TriangleRef};
 use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
 use crate::rop::{BlendMode, BlockRows, DeferredClear, DepthFunc, Framebuffer, TileBuffer};
 use crate::setup::TriangleSetup;
-use crate::simd::{dispatch, prefetch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8};
+use crate::simd::{dispatch, prefetch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8, MaskOf};
+use crate::state::RenderState;
+
+use super::packed_rows::{packing_saves_a_row, PackedRows};
 
 /// Fragment counters of one tile.
 #[derive(Clone, Copy, Debug, Default)]
@@ -75,7 +78,9 @@ pub(super) fn raster_tiles(
         .tiles_mut()
         .par_iter_mut()
         .enumerate()
-        .map(|(tile_index, tile)| {
+        // The storage for packed rows is made once per piece of work rayon splits off, not
+        // once per tile.
+        .map_init(PackedRows::new, |packed, (tile_index, tile)| {
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();
             let mut coverage = BlockCoverage::default();
@@ -102,7 +107,7 @@ pub(super) fn raster_tiles(
                 let attrs = geometry.attrs(t);
                 // No `materialize`: the per-pixel path writes each block's pending clear
                 // together with the first triangle that reaches the block.
-                let c = draw.raster(tri, attrs, &coverage, tile, isa);
+                let c = draw.raster(tri, attrs, &coverage, packed, tile, isa);
                 counters = RasterCounters::sum(counters, c);
             }
             counters
@@ -136,6 +141,7 @@ pub(super) fn shade_triangle<S: Shader>(
     tri: &TriangleSetup,
     attrs: &[f32],
     coverage: &BlockCoverage,
+    packed: &mut PackedRows,
     tile: &mut TileBuffer,
     isa: Isa,
 ) -> RasterCounters {
@@ -144,6 +150,7 @@ pub(super) fn shade_triangle<S: Shader>(
         tri,
         attrs,
         coverage,
+        packed,
         tile,
         isa,
     })
@@ -155,6 +162,7 @@ struct ShadeTriangleJob<'k, 'a, S: Shader> {
     tri: &'k TriangleSetup,
     attrs: &'k [f32],
     coverage: &'k BlockCoverage,
+    packed: &'k mut PackedRows,
     tile: &'k mut TileBuffer,
     isa: Isa,
 }
@@ -179,6 +187,7 @@ impl<S: Shader> LaneProgramJob for ShadeTriangleJob<'_, '_, S> {
                         tri: self.tri,
                         attrs: self.attrs,
                         coverage: self.coverage,
+                        packed: self.packed,
                         tile: self.tile,
                     },
                 )
@@ -289,6 +298,34 @@ impl<L: Lanes> TriangleLanes<L> {
             .min(self.z_range[1])
     }
 
+    /// What the fragment program sees of the lanes `active` of `tri` with barycentrics `bary`
+    /// and depths `depth`, lane 0 at pixel `[x, y]`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn fragments<'i>(
+        &self,
+        tri: &TriangleSetup,
+        interpolation: &'i Interpolation<'i>,
+        active: MaskOf<L>,
+        depth: L::F32,
+        bary: [L::F32; 3],
+        [x, y]: [i32; 2],
+    ) -> FragmentLanes<'i, L> {
+        let (weights, w) = self.perspective_weights(bary);
+        FragmentLanes {
+            lanes: self.zero.lanes(),
+            x: x as u32,
+            y: y as u32,
+            active,
+            depth,
+            primitive_id: tri.primitive_id,
+            front_facing: tri.front_facing(),
+            weights,
+            w,
+            interpolation,
+        }
+    }
+
     /// Perspective-correct weights and `w` from screen-space barycentrics.
     #[inline(always)]
     pub(super) fn perspective_weights(&self, [l0, l1, l2]: [L::F32; 3]) -> ([L::F32; 3], L::F32) {
@@ -342,6 +379,7 @@ struct ShadeTriangle<
     tri: &'k TriangleSetup,
     attrs: &'k [f32],
     coverage: &'k BlockCoverage,
+    packed: &'k mut PackedRows,
     tile: &'k mut TileBuffer,
 }
 
@@ -358,6 +396,7 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
             tri,
             attrs,
             coverage,
+            packed,
             tile,
         } = self;
         let state = &draw.state;
@@ -377,18 +416,21 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
         let [v0x, v0y] = tri.pos_subpixel[0];
         let mut counters = RasterCounters::default();
         let blocks_can_reject = draw.rejects_by_depth_bound();
-        // Interpolated depth is clamped to the vertex range, so when that range lies in
-        // [0, 1] no lane can fall outside it and the per-row range test is skipped (a NaN
-        // bound fails the comparison and keeps the test).
-        let depth_needs_range_test = !(tri.depth_range[0] >= 0.0 && tri.depth_range[1] <= 1.0);
-        // Replace ignores the stored colour and passes the sanitised source through: nothing
-        // to load, and nothing new to sanitise after blending.
-        let blend_reads_target = !OPAQUE_LESS && state.blend != BlendMode::Replace;
-        let depth_test = OPAQUE_LESS || state.depth_test;
-        let depth_write = OPAQUE_LESS || state.depth_write;
-        // LESS, every built-in material's test, is compared directly: the general function is a
-        // jump table in the row loop.
-        let depth_less = OPAQUE_LESS || state.depth_func == DepthFunc::Less;
+        let rules = RowRules {
+            state,
+            // Interpolated depth is clamped to the vertex range, so when that range lies in
+            // [0, 1] no lane can fall outside it and the per-row range test is skipped (a NaN
+            // bound fails the comparison and keeps the test).
+            depth_needs_range_test: !(tri.depth_range[0] >= 0.0 && tri.depth_range[1] <= 1.0),
+            // Replace ignores the stored colour and passes the sanitised source through:
+            // nothing to load, and nothing new to sanitise after blending.
+            blend_reads_target: !OPAQUE_LESS && state.blend != BlendMode::Replace,
+            depth_test: OPAQUE_LESS || state.depth_test,
+            depth_write: OPAQUE_LESS || state.depth_write,
+            // LESS, every built-in material's test, is compared directly: the general function
+            // is a jump table in the row loop.
+            depth_less: OPAQUE_LESS || state.depth_func == DepthFunc::Less,
+        };
 
         for block in coverage.blocks() {
             // Depth hierarchy, second level: a block whose every stored depth is in front of the
@@ -409,118 +451,117 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
             let mut kept_bits = 0u64;
             let columns = triangle.column_terms(lanes, pixel_center(block.x as i64) - v0x);
             let mut rows = tile.block_rows_mut(TileBuffer::index(block.x, block.y));
-            for row in 0..8 {
-                let at = BlockRows::row_offset(row);
-                let written = 'row: {
+            if P::PACKED_ROWS && !CONSTANT && packing_saves_a_row(block.mask) {
+                // The rows' tests, their fragments packed one after another.
+                let mut row_active = [0u8; 8];
+                let mut row_depth = [zero; 8];
+                let mut count = 0;
+                for row in 0..8 {
                     let row_bits = (block.mask >> (8 * row)) as u8;
                     if row_bits == 0 {
-                        break 'row None;
+                        continue;
                     }
-                    let (x, y) = (block.x, block.y + row as i32);
-                    let bary =
-                        triangle.barycentrics_in_row(lanes, &columns, pixel_center(y as i64) - v0y);
+                    let dy = pixel_center((block.y + row as i32) as i64) - v0y;
+                    let bary = triangle.barycentrics_in_row(lanes, &columns, dy);
                     let depth = triangle.depth(bary);
-                    let mut active = lanes.mask_from_bits(row_bits);
-                    if depth_needs_range_test {
-                        // Outside [0, 1] (or NaN): beyond the near or far plane.
-                        active = active.and(depth.simd_ge(zero)).and(depth.simd_le(one));
+                    let at = BlockRows::row_offset(row);
+                    let active = rules.active(lanes, row_bits, depth, &rows, at, &pending);
+                    let bits = active.bits();
+                    if bits == 0 {
+                        continue;
                     }
-                    if depth_test {
-                        let stored = match &pending {
-                            Some(clear) => clear.depth,
-                            None => lanes.load_f32(&rows.depth[at..at + 8]),
-                        };
-                        let passes = if depth_less {
-                            depth.simd_lt(stored)
-                        } else {
-                            state.depth_func.passes_lanes(lanes, depth, stored)
-                        };
-                        active = active.and(passes);
-                    }
-                    let active_bits = active.bits();
-                    if active_bits == 0 {
-                        break 'row None;
-                    }
-                    shaded_bits |= (active_bits as u64) << (8 * row);
-                    let (weights, w) = triangle.perspective_weights(bary);
-                    let fragments = FragmentLanes {
-                        lanes,
-                        x: x as u32,
-                        y: y as u32,
+                    (row_active[row], row_depth[row]) = (bits, depth);
+                    packed.pack(lanes, count, bits, bary, depth);
+                    count += bits.count_ones() as usize;
+                }
+                // The program, eight packed fragments at a time.
+                for group in (0..count).step_by(8) {
+                    let active =
+                        lanes.mask_from_bits((0xffu16 >> (8 - (count - group).min(8))) as u8);
+                    let (bary, depth) = packed.group(lanes, group, one);
+                    let shaded = program.fragment_lanes(&triangle.fragments(
+                        tri,
+                        &interpolation,
                         active,
                         depth,
-                        primitive_id: tri.primitive_id,
-                        front_facing: tri.front_facing(),
-                        weights,
-                        w,
-                        interpolation: &interpolation,
-                    };
-                    let shaded = program.fragment_lanes(&fragments);
-                    let keep = active.and(shaded.keep);
-                    let keep_bits = keep.bits();
-                    if keep_bits == 0 {
-                        break 'row None;
-                    }
-                    kept_bits |= (keep_bits as u64) << (8 * row);
-                    // NaN channels are written as 0 and counted, before and after blending
-                    // (blending infinities can make NaN) (robust branch).
-                    let (src, nan_src) = zero_nan_channels(lanes, shaded.color, keep);
-                    counters.nan_channels += nan_src;
-                    let blended = if blend_reads_target {
-                        let dst = match &pending {
-                            Some(clear) => clear.color,
-                            None => [
-                                lanes.load_f32(&rows.color[0][at..at + 8]),
-                                lanes.load_f32(&rows.color[1][at..at + 8]),
-                                lanes.load_f32(&rows.color[2][at..at + 8]),
-                                lanes.load_f32(&rows.color[3][at..at + 8]),
-                            ],
-                        };
-                        let blended = state.blend.blend_lanes(lanes, src, dst);
-                        let (blended, nan_blended) = zero_nan_channels(lanes, blended, keep);
-                        counters.nan_channels += nan_blended;
-                        blended
+                        bary,
+                        [block.x, block.y],
+                    ));
+                    packed.store_shaded::<L>(
+                        group,
+                        shaded.color,
+                        active.and(shaded.keep),
+                        [zero, one],
+                    );
+                }
+                // Each row's results back in its lanes, blended and stored.
+                let mut group_at = 0;
+                for row in 0..8 {
+                    let at = BlockRows::row_offset(row);
+                    let bits = row_active[row];
+                    let written = if bits == 0 {
+                        None
                     } else {
-                        src
+                        shaded_bits |= (bits as u64) << (8 * row);
+                        let (color, keep) = packed.unpack(lanes, group_at, bits, zero);
+                        group_at += bits.count_ones() as usize;
+                        kept_bits |= (keep.bits() as u64) << (8 * row);
+                        rules
+                            .finish(lanes, color, keep, &rows, at, &pending, &mut counters)
+                            .map(|color| (color, row_depth[row], keep))
                     };
-                    Some((blended, depth, keep))
-                };
-                let [r, g, b, a] = &mut rows.color;
-                match &pending {
-                    None => {
-                        if let Some((color, depth, keep)) = written {
-                            color[0].store_masked(keep, &mut r[at..at + 8]);
-                            color[1].store_masked(keep, &mut g[at..at + 8]);
-                            color[2].store_masked(keep, &mut b[at..at + 8]);
-                            color[3].store_masked(keep, &mut a[at..at + 8]);
-                            if depth_write {
-                                depth.store_masked(keep, &mut rows.depth[at..at + 8]);
-                            }
+                    rules.store(lanes, written, &mut rows, at, &pending);
+                }
+            } else {
+                for row in 0..8 {
+                    let at = BlockRows::row_offset(row);
+                    let written = 'row: {
+                        let row_bits = (block.mask >> (8 * row)) as u8;
+                        if row_bits == 0 {
+                            break 'row None;
                         }
-                    }
-                    // The whole row: the triangle's values where kept, the clear elsewhere (a
-                    // row the triangle did not write keeps no lane).
-                    Some(clear) => {
-                        let (color, depth, keep) =
-                            written.unwrap_or((clear.color, clear.depth, lanes.mask_all(false)));
-                        let depth = if depth_write { depth } else { clear.depth };
-                        keep.select_f32(color[0], clear.color[0])
-                            .store(&mut r[at..at + 8]);
-                        keep.select_f32(color[1], clear.color[1])
-                            .store(&mut g[at..at + 8]);
-                        keep.select_f32(color[2], clear.color[2])
-                            .store(&mut b[at..at + 8]);
-                        keep.select_f32(color[3], clear.color[3])
-                            .store(&mut a[at..at + 8]);
-                        keep.select_f32(depth, clear.depth)
-                            .store(&mut rows.depth[at..at + 8]);
-                    }
+                        let y = block.y + row as i32;
+                        let bary = triangle.barycentrics_in_row(
+                            lanes,
+                            &columns,
+                            pixel_center(y as i64) - v0y,
+                        );
+                        let depth = triangle.depth(bary);
+                        let active = rules.active(lanes, row_bits, depth, &rows, at, &pending);
+                        let active_bits = active.bits();
+                        if active_bits == 0 {
+                            break 'row None;
+                        }
+                        shaded_bits |= (active_bits as u64) << (8 * row);
+                        let shaded = program.fragment_lanes(&triangle.fragments(
+                            tri,
+                            &interpolation,
+                            active,
+                            depth,
+                            bary,
+                            [block.x, y],
+                        ));
+                        let keep = active.and(shaded.keep);
+                        kept_bits |= (keep.bits() as u64) << (8 * row);
+                        rules
+                            .finish(
+                                lanes,
+                                shaded.color,
+                                keep,
+                                &rows,
+                                at,
+                                &pending,
+                                &mut counters,
+                            )
+                            .map(|color| (color, depth, keep))
+                    };
+                    rules.store(lanes, written, &mut rows, at, &pending);
                 }
             }
             let shaded_count = shaded_bits.count_ones() as u64;
             counters.shaded += shaded_count;
             counters.discarded += shaded_count - kept_bits.count_ones() as u64;
-            if depth_write && kept_bits != 0 {
+            if rules.depth_write && kept_bits != 0 {
                 // Keep the block's bound exact: the largest of its 64 depths.
                 let mut largest = lanes.load_f32(&rows.depth[..8]);
                 for row in 1..8 {
@@ -531,5 +572,137 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
             }
         }
         counters
+    }
+}
+
+/// The render state's per-row decisions of one kernel call, made before its first row.
+struct RowRules<'s> {
+    state: &'s RenderState,
+    /// The triangle's depth range is not within [0, 1] (or is NaN): each row tests its depths.
+    depth_needs_range_test: bool,
+    /// Blending reads the stored colour (not Replace).
+    blend_reads_target: bool,
+    depth_test: bool,
+    depth_write: bool,
+    /// The depth test is LESS.
+    depth_less: bool,
+}
+
+impl RowRules<'_> {
+    /// The lanes of the row at `at` in `rows` that hold a fragment: covered (`row_bits`),
+    /// inside [0, 1] in depth where that needs a test, and passing the depth test against the
+    /// stored depth (the pending clear's where there is one).
+    #[inline(always)]
+    fn active<L: Lanes>(
+        &self,
+        lanes: L,
+        row_bits: u8,
+        depth: L::F32,
+        rows: &BlockRows<'_>,
+        at: usize,
+        pending: &Option<ClearLanes<L>>,
+    ) -> MaskOf<L> {
+        let mut active = lanes.mask_from_bits(row_bits);
+        if self.depth_needs_range_test {
+            // Outside [0, 1] (or NaN): beyond the near or far plane.
+            active = active
+                .and(depth.simd_ge(lanes.splat_f32(0.0)))
+                .and(depth.simd_le(lanes.splat_f32(1.0)));
+        }
+        if self.depth_test {
+            let stored = match pending {
+                Some(clear) => clear.depth,
+                None => lanes.load_f32(&rows.depth[at..at + 8]),
+            };
+            let passes = if self.depth_less {
+                depth.simd_lt(stored)
+            } else {
+                self.state.depth_func.passes_lanes(lanes, depth, stored)
+            };
+            active = active.and(passes);
+        }
+        active
+    }
+
+    /// The colour a row writes where `keep` is set, from the program's `src`: NaN channels
+    /// written as 0 and counted, before and after blending with the stored colour (blending
+    /// infinities can make NaN) (robust branch). `None` when no lane is kept.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn finish<L: Lanes>(
+        &self,
+        lanes: L,
+        src: [L::F32; 4],
+        keep: MaskOf<L>,
+        rows: &BlockRows<'_>,
+        at: usize,
+        pending: &Option<ClearLanes<L>>,
+        counters: &mut RasterCounters,
+    ) -> Option<[L::F32; 4]> {
+        if keep.none() {
+            return None;
+        }
+        let (src, nan_src) = zero_nan_channels(lanes, src, keep);
+        counters.nan_channels += nan_src;
+        if !self.blend_reads_target {
+            return Some(src);
+        }
+        let dst = match pending {
+            Some(clear) => clear.color,
+            None => [
+                lanes.load_f32(&rows.color[0][at..at + 8]),
+                lanes.load_f32(&rows.color[1][at..at + 8]),
+                lanes.load_f32(&rows.color[2][at..at + 8]),
+                lanes.load_f32(&rows.color[3][at..at + 8]),
+            ],
+        };
+        let blended = self.state.blend.blend_lanes(lanes, src, dst);
+        let (blended, nan_blended) = zero_nan_channels(lanes, blended, keep);
+        counters.nan_channels += nan_blended;
+        Some(blended)
+    }
+
+    /// Stores the row at `at`: `written` (colour, depth and the kept lanes) where kept; with a
+    /// pending clear, the whole row, the clear elsewhere (a row the triangle did not write
+    /// keeps no lane).
+    #[inline(always)]
+    #[allow(clippy::type_complexity)]
+    fn store<L: Lanes>(
+        &self,
+        lanes: L,
+        written: Option<([L::F32; 4], L::F32, MaskOf<L>)>,
+        rows: &mut BlockRows<'_>,
+        at: usize,
+        pending: &Option<ClearLanes<L>>,
+    ) {
+        let [r, g, b, a] = &mut rows.color;
+        match pending {
+            None => {
+                if let Some((color, depth, keep)) = written {
+                    color[0].store_masked(keep, &mut r[at..at + 8]);
+                    color[1].store_masked(keep, &mut g[at..at + 8]);
+                    color[2].store_masked(keep, &mut b[at..at + 8]);
+                    color[3].store_masked(keep, &mut a[at..at + 8]);
+                    if self.depth_write {
+                        depth.store_masked(keep, &mut rows.depth[at..at + 8]);
+                    }
+                }
+            }
+            Some(clear) => {
+                let (color, depth, keep) =
+                    written.unwrap_or((clear.color, clear.depth, lanes.mask_all(false)));
+                let depth = if self.depth_write { depth } else { clear.depth };
+                keep.select_f32(color[0], clear.color[0])
+                    .store(&mut r[at..at + 8]);
+                keep.select_f32(color[1], clear.color[1])
+                    .store(&mut g[at..at + 8]);
+                keep.select_f32(color[2], clear.color[2])
+                    .store(&mut b[at..at + 8]);
+                keep.select_f32(color[3], clear.color[3])
+                    .store(&mut a[at..at + 8]);
+                keep.select_f32(depth, clear.depth)
+                    .store(&mut rows.depth[at..at + 8]);
+            }
+        }
     }
 }

@@ -18,6 +18,7 @@ mod draw;
 mod fragment;
 mod geometry;
 mod multisample;
+mod packed_rows;
 mod points_lines;
 mod sanitize;
 mod shader;

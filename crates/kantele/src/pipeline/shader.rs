@@ -88,6 +88,15 @@ pub trait LaneProgram: Sync {
     /// kernels are large (the textured ones).
     const CONSTANT_KERNELS: bool = true;
 
+    /// Whether the per-pixel kernel may hand this program the fragments of several rows of a
+    /// block packed together (where small triangles leave most lanes of a row empty, so that
+    /// the program runs once for up to eight fragments instead of once per row): only for a
+    /// program that computes each lane from that lane's own values alone and reads neither
+    /// [`FragmentLanes::x`] nor [`FragmentLanes::y`] (for a packed group they name the block's
+    /// first pixel, not lane 0's). Lanes then hold the same values as in their own row, so
+    /// the picture is the same.
+    const PACKED_ROWS: bool = false;
+
     /// Shades the active lanes of one row, as [`Shader::fragment_lanes`].
     fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L>;
 }

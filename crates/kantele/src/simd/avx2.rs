@@ -326,6 +326,10 @@ impl F32x8 for Avx2F32 {
         self.to_array()[k]
     }
     #[inline(always)]
+    fn permute(self, index: Avx2I32) -> Avx2F32 {
+        avx!(Avx2F32(_mm256_permutevar8x32_ps(self.0, index.0)))
+    }
+    #[inline(always)]
     fn reduce_min(self) -> f32 {
         reduce!(self.0, _mm_min_ps)
     }

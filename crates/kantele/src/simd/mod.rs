@@ -408,12 +408,28 @@ pub trait F32x8:
     fn from_bits(bits: <Self::Lanes as Lanes>::I32) -> Self;
     /// Lane `k`. Panics if `k >= 8`.
     fn extract(self, k: usize) -> f32;
+    /// Lanes moved: lane `k` of the result is lane `index[k] mod 8` of `self` (AVX2
+    /// `vpermps`; the bits of the value move unchanged).
+    fn permute(self, index: <Self::Lanes as Lanes>::I32) -> Self;
     /// The [`min`](F32x8::min) of all lanes, as the tree `min(min(min(a0,a4), min(a2,a6)),
     /// min(min(a1,a5), min(a3,a7)))`.
     fn reduce_min(self) -> f32;
     /// The [`max`](F32x8::max) of all lanes, in the same tree order as
     /// [`reduce_min`](F32x8::reduce_min).
     fn reduce_max(self) -> f32;
+}
+
+/// [`F32x8::permute`] through arrays, for implementations without a permutation across all
+/// eight lanes (SSE2 and NEON hold two 4-lane halves).
+#[inline(always)]
+fn permute_through_arrays<L: Lanes>(value: L::F32, index: L::I32) -> L::F32 {
+    let lanes = value.lanes();
+    let (value, index) = (value.to_array(), index.to_array());
+    let mut out = [0.0; 8];
+    for (lane, &i) in out.iter_mut().zip(&index) {
+        *lane = value[(i & 7) as usize];
+    }
+    lanes.f32_from_array(out)
 }
 
 /// 8 × `i32`, two's complement: arithmetic wraps (the low 32 bits).

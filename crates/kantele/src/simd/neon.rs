@@ -355,6 +355,10 @@ impl F32x8 for NeonF32 {
         self.to_array()[k]
     }
     #[inline(always)]
+    fn permute(self, index: NeonI32) -> Self {
+        super::permute_through_arrays::<Neon>(self, index)
+    }
+    #[inline(always)]
     fn reduce_min(self) -> f32 {
         reduce(self.0, self.1, min4)
     }

@@ -292,6 +292,14 @@ impl F32x8 for ScalarF32 {
         self.0[k]
     }
     #[inline(always)]
+    fn permute(self, index: ScalarI32) -> ScalarF32 {
+        let mut out = [0.0; 8];
+        for (value, &i) in out.iter_mut().zip(&index.0) {
+            *value = self.0[(i & 7) as usize];
+        }
+        ScalarF32(out)
+    }
+    #[inline(always)]
     fn reduce_min(self) -> f32 {
         reduce(self.0, min_f32)
     }

@@ -560,6 +560,10 @@ impl<T: SseLevel> F32x8 for SseF32<T> {
         self.to_array()[k]
     }
     #[inline(always)]
+    fn permute(self, index: SseI32<T>) -> Self {
+        super::permute_through_arrays::<T>(self, index)
+    }
+    #[inline(always)]
     fn reduce_min(self) -> f32 {
         reduce!(self.0, self.1, _mm_min_ps)
     }

@@ -165,6 +165,14 @@ impl LaneKernel for AllOps<'_> {
             ("from_bits", f32_bits(L::F32::from_bits(ia).to_array())),
             ("extract(0)", one(a.extract(0).to_bits())),
             ("extract(6)", one(a.extract(6).to_bits())),
+            ("permute", f32_bits(a.permute(ia).to_array())),
+            (
+                "permute(reverse)",
+                f32_bits(
+                    a.permute(lanes.i32_from_array([7, 6, 5, 4, 3, 2, 1, 0]))
+                        .to_array(),
+                ),
+            ),
             ("reduce_min", one(a.reduce_min().to_bits())),
             ("reduce_max", one(a.reduce_max().to_bits())),
             ("i32 add", i32_bits((ia + ib).to_array())),
