@@ -23,6 +23,48 @@ pub struct Timing {
     pub max: f64,
 }
 
+/// Median milliseconds of each stage over the timed frames, as the backend reports them
+/// ([`kantele::stats::FrameStats`]): where a frame's time goes, and how much of it runs serially
+/// when the thread count changes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StageTimes {
+    /// Vertex shading, primitive assembly, clipping, culling and setup.
+    pub geometry: f64,
+    /// Sorting triangles into tile bins.
+    pub binning: f64,
+    /// Rasterizing, shading and merging on every tile.
+    pub raster: f64,
+}
+
+impl StageTimes {
+    /// The medians of `stages` (one `[geometry, binning, raster]` per frame, milliseconds);
+    /// `None` for no frames, or when every stage time is zero (a backend that does not time
+    /// its stages, such as OpenGL's).
+    pub fn median_of(stages: &[[f64; 3]]) -> Option<Self> {
+        if stages.iter().flatten().all(|&t| t == 0.0) {
+            return None;
+        }
+        let median = |k: usize| -> Option<f64> {
+            let times: Vec<f64> = stages.iter().map(|s| s[k]).collect();
+            summarize(&times).map(|t| t.median)
+        };
+        Some(Self {
+            geometry: median(0)?,
+            binning: median(1)?,
+            raster: median(2)?,
+        })
+    }
+}
+
+/// Timed frames: the whole frames, and their stages where the backend times them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameTimes {
+    /// Whole frames.
+    pub frames: Timing,
+    /// Median stage times.
+    pub stages: Option<StageTimes>,
+}
+
 /// Median, min and max of frame times; `None` for no frames.
 pub fn summarize(times: &[f64]) -> Option<Timing> {
     if times.is_empty() {
@@ -58,7 +100,7 @@ struct Row {
     isa: String,
     /// Samples per pixel of the colour frames.
     msaa: usize,
-    result: Result<Timing, String>,
+    result: Result<FrameTimes, String>,
     ratio: Option<f64>,
 }
 
@@ -67,17 +109,28 @@ fn time_frames(
     view: &FrameView,
     warmup: u32,
     frames: u32,
-) -> Result<Timing, String> {
+) -> Result<FrameTimes, String> {
     for _ in 0..warmup {
         backend.render(view).map_err(|e| e.to_string())?;
     }
     let mut times = Vec::with_capacity(frames as usize);
+    let mut stages = Vec::with_capacity(frames as usize);
+    let ms = |d: std::time::Duration| d.as_secs_f64() * 1000.0;
     for _ in 0..frames {
         let start = Instant::now();
-        backend.render(view).map_err(|e| e.to_string())?;
-        times.push(start.elapsed().as_secs_f64() * 1000.0);
+        let stats = backend.render(view).map_err(|e| e.to_string())?;
+        times.push(ms(start.elapsed()));
+        stages.push([
+            ms(stats.geometry_time),
+            ms(stats.binning_time),
+            ms(stats.raster_time),
+        ]);
     }
-    summarize(&times).ok_or_else(|| "no frames timed".to_string())
+    let frames = summarize(&times).ok_or_else(|| "no frames timed".to_string())?;
+    Ok(FrameTimes {
+        frames,
+        stages: StageTimes::median_of(&stages),
+    })
 }
 
 fn print_table(rows: &[Row], ratios: bool) {
@@ -107,7 +160,7 @@ fn print_table(rows: &[Row], ratios: bool) {
             r.scene, size, r.triangles, r.draws, r.backend, r.renderer, r.threads, r.isa, r.msaa
         );
         match &r.result {
-            Ok(t) => {
+            Ok(FrameTimes { frames: t, .. }) => {
                 line.push_str(&format!(
                     " {:>10.3} {:>10.3} {:>10.3}",
                     t.median, t.min, t.max
@@ -157,7 +210,7 @@ fn print_side_by_side(rows: &[Row], backends: &[String]) {
         );
         for r in scene_rows {
             match &r.result {
-                Ok(t) => line.push_str(&format!(" {:>10.2}", t.median)),
+                Ok(t) => line.push_str(&format!(" {:>10.2}", t.frames.median)),
                 Err(_) => line.push_str(&format!(" {:>10}", "-")),
             }
         }
@@ -242,7 +295,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 }
                 eprintln!("kantele: warning: {label}: {name}: {e}");
             }
-            let median = result.as_ref().ok().map(|t| t.median);
+            let median = result.as_ref().ok().map(|t| t.frames.median);
             any_ok |= median.is_some();
             if i == 0 {
                 reference = median;
@@ -266,10 +319,13 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 ratio,
             };
             if args.json {
-                let (median, min, max, error) = match &row.result {
-                    Ok(t) => (Some(t.median), Some(t.min), Some(t.max), None),
-                    Err(e) => (None, None, None, Some(e.clone())),
+                let (median, min, max, stages, error) = match &row.result {
+                    Ok(FrameTimes { frames: t, stages }) => {
+                        (Some(t.median), Some(t.min), Some(t.max), *stages, None)
+                    }
+                    Err(e) => (None, None, None, None, Some(e.clone())),
                 };
+                let stage = |pick: fn(&StageTimes) -> f64| stages.as_ref().map(pick);
                 println!(
                     "{}",
                     json!({
@@ -279,6 +335,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                         "backend": row.backend, "renderer": row.renderer, "threads": row.threads, "isa": row.isa, "msaa": row.msaa,
                         "frames": args.frames, "warmup": args.warmup,
                         "median_ms": median, "min_ms": min, "max_ms": max,
+                        "geometry_ms": stage(|s| s.geometry), "binning_ms": stage(|s| s.binning),
+                        "raster_ms": stage(|s| s.raster),
                         "ratio": row.ratio, "available": error.is_none(), "error": error,
                     })
                 );
@@ -313,6 +371,21 @@ mod tests {
         assert_eq!((t.median, t.min, t.max), (2.0, 1.0, 3.0));
         let t = summarize(&[4.0, 1.0, 2.0, 3.0]).unwrap();
         assert_eq!((t.median, t.min, t.max), (2.5, 1.0, 4.0));
+    }
+
+    #[test]
+    fn stage_medians_per_stage_and_none_without_stage_times() {
+        assert_eq!(StageTimes::median_of(&[]), None);
+        assert_eq!(StageTimes::median_of(&[[0.0; 3], [0.0; 3]]), None);
+        let s = StageTimes::median_of(&[[1.0, 0.5, 9.0], [3.0, 0.0, 7.0], [2.0, 0.25, 8.0]]);
+        assert_eq!(
+            s,
+            Some(StageTimes {
+                geometry: 2.0,
+                binning: 0.25,
+                raster: 8.0
+            })
+        );
     }
 
     #[test]

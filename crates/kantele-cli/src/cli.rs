@@ -423,7 +423,9 @@ pub struct BenchArgs {
     /// CPU backend options.
     #[command(flatten)]
     pub cpu: CpuArgs,
-    /// One JSON object per line instead of a table.
+    /// One JSON object per line instead of a table; with the medians of the CPU backend's
+    /// stages too (`geometry_ms`, `binning_ms`, `raster_ms`; null for backends that do not time
+    /// them).
     #[arg(long)]
     pub json: bool,
 }

@@ -57,6 +57,18 @@ fn bench_two_frames() {
     assert_eq!(v["frames"], 2);
     assert!(v["median_ms"].as_f64().unwrap() > 0.0);
     assert!(v["min_ms"].as_f64().unwrap() <= v["max_ms"].as_f64().unwrap());
+    // The CPU backend times its stages: medians within the slowest frame, the raster's not 0
+    // (the cube covers pixels).
+    for stage in ["geometry_ms", "binning_ms", "raster_ms"] {
+        let t = v[stage]
+            .as_f64()
+            .unwrap_or_else(|| panic!("{stage} in {out}"));
+        assert!(
+            t >= 0.0 && t <= v["max_ms"].as_f64().unwrap(),
+            "{stage} {t} in {out}"
+        );
+    }
+    assert!(v["raster_ms"].as_f64().unwrap() > 0.0, "{out}");
     let o = kantele(&[
         "bench",
         "--builtin",

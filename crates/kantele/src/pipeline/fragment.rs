@@ -78,8 +78,12 @@ pub(super) fn raster_tiles(
         .tiles_mut()
         .par_iter_mut()
         .enumerate()
-        // The storage for packed rows is made once per piece of work rayon splits off, not
-        // once per tile.
+        // Runs of at most four tiles, each a piece of work another thread can take: left to its
+        // own splitting, rayon gave each of two threads a run of tiles it could not give away,
+        // and a picture whose costly tiles lay in one half waited for one thread (single tiles
+        // balanced as well, and cost more on full-screen fill).
+        .with_max_len(4)
+        // The storage for packed rows is made once per piece of work (2 KB on the stack).
         .map_init(PackedRows::new, |packed, (tile_index, tile)| {
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();

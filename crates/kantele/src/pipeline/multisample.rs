@@ -48,6 +48,8 @@ pub(super) fn raster_tiles_multisampled(
         .tiles_mut()
         .par_iter_mut()
         .enumerate()
+        // Runs of at most four tiles another thread can take (as at 1×).
+        .with_max_len(4)
         .map(|(tile_index, tile)| {
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();

@@ -46,11 +46,10 @@ impl Texture {
         duv_dy: [L::F32; 2],
         active: MaskOf<L>,
     ) -> [L::F32; 4] {
-        let pot = self.width().is_power_of_two() && self.height().is_power_of_two();
         self.sample_grad_lanes_from::<L>(
             self.lane_texels(),
             sampler,
-            pot,
+            self.sizes(),
             uv,
             duv_dx,
             duv_dy,
@@ -69,7 +68,19 @@ impl Texture {
         Some(TrilinearRepeat15 {
             texture: self,
             copy,
+            sizes: self.sizes(),
         })
+    }
+
+    /// This texture's [`Sizes`].
+    #[inline(always)]
+    fn sizes(&self) -> Sizes {
+        Sizes {
+            width: self.width() as f32,
+            height: self.height() as f32,
+            max_level: self.max_level() as f32,
+            pot: self.width().is_power_of_two() && self.height().is_power_of_two(),
+        }
     }
 
     /// Where [`Texture::sample_grad_lanes`] reads the texels: the decoded copy of an sRGB
@@ -97,15 +108,14 @@ impl Texture {
         }
     }
 
-    /// [`Texture::sample_grad_lanes`] reading `source`; `pot`: both sides of level 0 are powers
-    /// of two (and so those of every level).
+    /// [`Texture::sample_grad_lanes`] reading `source`; `sizes`: this texture's ([`Texture::sizes`]).
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     fn sample_grad_lanes_from<L: Lanes>(
         &self,
         source: TexelSource<'_>,
         sampler: &Sampler,
-        pot: bool,
+        sizes: Sizes,
         uv: [L::F32; 2],
         duv_dx: [L::F32; 2],
         duv_dy: [L::F32; 2],
@@ -128,13 +138,14 @@ impl Texture {
         if live.none() {
             return [zero; 4];
         }
-        let rho2 = self.footprint_lanes::<L>(duv_dx, duv_dy);
+        let pot = sizes.pot;
+        let rho2 = footprint_lanes::<L>(sizes, duv_dx, duv_dy);
         // λ ≤ 0 exactly where ρ² ≤ 1 (see `log2_normal`), so when every live lane is magnified
         // the level of detail is not needed: level 0, no blend.
         let selection = if rho2.simd_le(lanes.splat_f32(1.0)).or(live.not()).all() {
             LevelSelection::<L>::magnified(lanes, sampler)
         } else {
-            LevelSelection::<L>::new(self, sampler, self.lod_lanes::<L>(rho2))
+            LevelSelection::<L>::new(sizes, sampler, lod_lanes::<L>(sizes, rho2))
         };
         let nearest = selection.nearest;
         let layout = self.level_layout(source);
@@ -170,40 +181,6 @@ impl Texture {
             *channel = live.select_f32(value.to_f32() * unit, zero);
         }
         out
-    }
-
-    /// Per-lane squared footprint `ρ² = max(|∂uv/∂x|², |∂uv/∂y|²)` in texels of level 0
-    /// ([`Texture::lod`]).
-    #[inline(always)]
-    fn footprint_lanes<L: Lanes>(&self, duv_dx: [L::F32; 2], duv_dy: [L::F32; 2]) -> L::F32 {
-        let lanes = duv_dx[0].lanes();
-        let width = lanes.splat_f32(self.width() as f32);
-        let height = lanes.splat_f32(self.height() as f32);
-        let (rx, ry) = (
-            footprint2::<L>(duv_dx, width, height),
-            footprint2::<L>(duv_dy, width, height),
-        );
-        // `f32::max` ignores a NaN operand; the lane `max` returns `ry` when either is NaN.
-        let ry_is_nan = ry.simd_ne(ry);
-        ry_is_nan.select_f32(rx, rx.max(ry))
-    }
-
-    /// Per-lane level of detail `λ = ½ log2 ρ²` ([`Texture::lod`]) from the squared footprint
-    /// ([`Texture::footprint_lanes`]): `−∞` where it is zero (or below the smallest normal
-    /// float), the last level where it is not finite.
-    #[inline(always)]
-    fn lod_lanes<L: Lanes>(&self, rho2: L::F32) -> L::F32 {
-        let lanes = rho2.lanes();
-        let normal = rho2
-            .simd_ge(lanes.splat_f32(f32::MIN_POSITIVE))
-            .and(rho2.simd_lt(lanes.splat_f32(f32::INFINITY)));
-        let tiny = rho2.simd_lt(lanes.splat_f32(f32::MIN_POSITIVE));
-        let lod = lanes.splat_f32(0.5) * log2_normal::<L>(rho2);
-        let fallback = tiny.select_f32(
-            lanes.splat_f32(f32::NEG_INFINITY),
-            lanes.splat_f32(self.max_level() as f32),
-        );
-        normal.select_f32(lod, fallback)
     }
 
     /// The texels one level per lane reads (`level` holds each lane's level index) at `uv`, as
@@ -310,6 +287,8 @@ pub(crate) struct TrilinearRepeat15<'t> {
     texture: &'t Texture,
     /// The texture's decoded copy ([`Texture::linear15`]).
     copy: &'t Linear15Copy,
+    /// The texture's sizes ([`Texture::sizes`]).
+    sizes: Sizes,
 }
 
 impl TrilinearRepeat15<'_> {
@@ -333,13 +312,66 @@ impl TrilinearRepeat15<'_> {
         self.texture.sample_grad_lanes_from::<L>(
             TexelSource::Linear15(self.copy),
             &Self::SAMPLER,
-            true,
+            // Powers of two by construction: stated here so that the wrap is compiled as a mask.
+            Sizes {
+                pot: true,
+                ..self.sizes
+            },
             uv,
             duv_dx,
             duv_dy,
             active,
         )
     }
+}
+
+/// A texture's level-0 sizes and last level as the sampler reads them, in `f32`: worked out
+/// once per draw for a [`TrilinearRepeat15`] (a program holding it then reloads nothing of the
+/// texture per row), once per call otherwise.
+#[derive(Clone, Copy, Debug)]
+struct Sizes {
+    /// Width of level 0 in texels.
+    width: f32,
+    /// Height of level 0 in texels.
+    height: f32,
+    /// Index of the last level.
+    max_level: f32,
+    /// Both sides of level 0 are powers of two (and so those of every level).
+    pot: bool,
+}
+
+/// Per-lane squared footprint `ρ² = max(|∂uv/∂x|², |∂uv/∂y|²)` in texels of level 0
+/// ([`Texture::lod`]) of a texture of `sizes`.
+#[inline(always)]
+fn footprint_lanes<L: Lanes>(sizes: Sizes, duv_dx: [L::F32; 2], duv_dy: [L::F32; 2]) -> L::F32 {
+    let lanes = duv_dx[0].lanes();
+    let width = lanes.splat_f32(sizes.width);
+    let height = lanes.splat_f32(sizes.height);
+    let (rx, ry) = (
+        footprint2::<L>(duv_dx, width, height),
+        footprint2::<L>(duv_dy, width, height),
+    );
+    // `f32::max` ignores a NaN operand; the lane `max` returns `ry` when either is NaN.
+    let ry_is_nan = ry.simd_ne(ry);
+    ry_is_nan.select_f32(rx, rx.max(ry))
+}
+
+/// Per-lane level of detail `λ = ½ log2 ρ²` ([`Texture::lod`]) from the squared footprint
+/// ([`footprint_lanes`]): `−∞` where it is zero (or below the smallest normal float), the last
+/// level of a texture of `sizes` where it is not finite.
+#[inline(always)]
+fn lod_lanes<L: Lanes>(sizes: Sizes, rho2: L::F32) -> L::F32 {
+    let lanes = rho2.lanes();
+    let normal = rho2
+        .simd_ge(lanes.splat_f32(f32::MIN_POSITIVE))
+        .and(rho2.simd_lt(lanes.splat_f32(f32::INFINITY)));
+    let tiny = rho2.simd_lt(lanes.splat_f32(f32::MIN_POSITIVE));
+    let lod = lanes.splat_f32(0.5) * log2_normal::<L>(rho2);
+    let fallback = tiny.select_f32(
+        lanes.splat_f32(f32::NEG_INFINITY),
+        lanes.splat_f32(sizes.max_level),
+    );
+    normal.select_f32(lod, fallback)
 }
 
 /// Where a texel source holds each level: the index of its first texel, and rows of `width +
@@ -456,10 +488,10 @@ impl<L: Lanes> LevelSelection<L> {
     /// OpenGL's level selection ([`Texture::sample_lod`]) per lane: λ ≤ 0 magnifies from level 0
     /// with the magnification filter; otherwise the minification filter picks the level(s).
     #[inline(always)]
-    fn new(texture: &Texture, sampler: &Sampler, lod: L::F32) -> Self {
+    fn new(sizes: Sizes, sampler: &Sampler, lod: L::F32) -> Self {
         let lanes = lod.lanes();
         let zero = lanes.splat_f32(0.0);
-        let max_level = lanes.splat_f32(texture.max_level() as f32);
+        let max_level = lanes.splat_f32(sizes.max_level);
         let magnified = lod.simd_gt(zero).not();
         let min_filter = sampler.min_filter;
         let nearest_min = min_filter.texel_filter() == Filter::Nearest;

@@ -46,7 +46,7 @@ impl LaneKernel for Sample<'_> {
             .sample_grad_lanes_from::<L>(
                 source,
                 &self.sampler,
-                self.texture.width().is_power_of_two() && self.texture.height().is_power_of_two(),
+                self.texture.sizes(),
                 pair(q.uv),
                 pair(q.duv_dx),
                 pair(q.duv_dy),
