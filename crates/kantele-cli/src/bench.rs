@@ -325,7 +325,6 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                     }
                     Err(e) => (None, None, None, None, Some(e.clone())),
                 };
-                let stage = |pick: fn(&StageTimes) -> f64| stages.as_ref().map(pick);
                 println!(
                     "{}",
                     json!({
@@ -335,8 +334,9 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                         "backend": row.backend, "renderer": row.renderer, "threads": row.threads, "isa": row.isa, "msaa": row.msaa,
                         "frames": args.frames, "warmup": args.warmup,
                         "median_ms": median, "min_ms": min, "max_ms": max,
-                        "geometry_ms": stage(|s| s.geometry), "binning_ms": stage(|s| s.binning),
-                        "raster_ms": stage(|s| s.raster),
+                        "geometry_ms": stages.map(|s| s.geometry),
+                        "binning_ms": stages.map(|s| s.binning),
+                        "raster_ms": stages.map(|s| s.raster),
                         "ratio": row.ratio, "available": error.is_none(), "error": error,
                     })
                 );

@@ -52,6 +52,12 @@ impl RasterCounters {
     }
 }
 
+/// Tiles in one piece of the raster's parallel work, at most: every piece is one another thread
+/// can take. Left to its own splitting, rayon gave each of two threads a run of tiles it could
+/// not give away, and a picture whose costly tiles lay in one half waited for one thread;
+/// single tiles balanced as well and cost more on full-screen fill.
+pub(super) const TILES_PER_PIECE: usize = 4;
+
 /// Rasterizes every tile's bin, tiles in parallel, each tile's triangles in order.
 pub(super) fn raster_tiles(
     framebuffer: &mut Framebuffer,
@@ -78,11 +84,7 @@ pub(super) fn raster_tiles(
         .tiles_mut()
         .par_iter_mut()
         .enumerate()
-        // Runs of at most four tiles, each a piece of work another thread can take: left to its
-        // own splitting, rayon gave each of two threads a run of tiles it could not give away,
-        // and a picture whose costly tiles lay in one half waited for one thread (single tiles
-        // balanced as well, and cost more on full-screen fill).
-        .with_max_len(4)
+        .with_max_len(TILES_PER_PIECE)
         // The storage for packed rows is made once per piece of work (2 KB on the stack).
         .map_init(PackedRows::new, |packed, (tile_index, tile)| {
             let rect = grid.tile_rect(tile_index);

@@ -19,7 +19,7 @@ use rayon::prelude::*;
 
 use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::draw::{DrawCall, DrawJob};
-use super::fragment::{binned_triangles, RasterCounters, TriangleLanes};
+use super::fragment::{binned_triangles, RasterCounters, TriangleLanes, TILES_PER_PIECE};
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
 use super::shader::{constant_varyings, vertex_varyings, FragmentLanes, Interpolation, Shader};
@@ -48,8 +48,7 @@ pub(super) fn raster_tiles_multisampled(
         .tiles_mut()
         .par_iter_mut()
         .enumerate()
-        // Runs of at most four tiles another thread can take (as at 1×).
-        .with_max_len(4)
+        .with_max_len(TILES_PER_PIECE)
         .map(|(tile_index, tile)| {
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();
