@@ -22,6 +22,7 @@ mod packed_rows;
 mod points_lines;
 mod sanitize;
 mod shader;
+mod warm;
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -39,6 +40,7 @@ pub use crate::state::{RenderState, Topology};
 use self::budget::FrameBudget;
 use self::draw::{DrawCall, DrawJob};
 use self::geometry::{run_geometry, GeometryScratch};
+use self::warm::{WarmWorkers, WARM_AFTER_FRAME, WARM_WHILE_QUEUING};
 use crate::error::RenderError;
 use crate::multisample::SampleCount;
 use crate::raster::bin::TileBins;
@@ -78,6 +80,14 @@ pub struct Renderer {
     scratch: GeometryScratch,
     timeout: Option<Duration>,
     cancel: Option<Arc<AtomicBool>>,
+    /// Keeps the workers awake from a frame's start until shortly after its end.
+    warm: Arc<WarmWorkers>,
+}
+
+impl Drop for Renderer {
+    fn drop(&mut self) {
+        self.warm.release();
+    }
 }
 
 impl Renderer {
@@ -101,6 +111,7 @@ impl Renderer {
             scratch: GeometryScratch::default(),
             timeout: options.timeout,
             cancel: None,
+            warm: WarmWorkers::new(),
         })
     }
 
@@ -212,6 +223,8 @@ impl Renderer {
         clear_color: Option<Vec4>,
         clear_depth: Option<f32>,
     ) -> Frame<'_, 'a> {
+        // The workers wake while the draws are queued, not in the frame's first stage.
+        self.warm.keep_awake(&self.pool, WARM_WHILE_QUEUING);
         Frame {
             renderer: self,
             clear_color,
@@ -340,6 +353,7 @@ impl<'a> Frame<'_, 'a> {
             scratch,
             timeout,
             cancel,
+            warm,
         } = renderer;
         let (strategy, isa) = (*strategy, *isa);
         let budget = FrameBudget::new(start, *timeout, cancel.as_deref());
@@ -388,6 +402,8 @@ impl<'a> Frame<'_, 'a> {
             stats.nan_color_channels = counters.nan_channels;
             stats.raster_time = raster_start.elapsed();
         });
+        // Awake a little longer, for the next frame of a loop.
+        warm.keep_awake(pool, WARM_AFTER_FRAME);
         stats.stopped = budget.stop();
         stats.empty_picture = stats.is_unexpectedly_empty();
         stats.total_time = start.elapsed();
