@@ -627,10 +627,14 @@ pub(super) fn log2_normal<L: Lanes>(x: L::F32) -> L::F32 {
         -0.272_680_46,
         0.170_623_42,
     ];
-    let mut poly = lanes.splat_f32(P[6]);
-    for &c in P[..6].iter().rev() {
-        poly = lanes.splat_f32(c) + t * poly;
-    }
+    // Estrin's scheme: pairs `P[k] + P[k+1]·t` combined with t² and t⁴, five dependent steps
+    // instead of Horner's twelve (the row's critical path runs through this).
+    let p = |k: usize| lanes.splat_f32(P[k]);
+    let t2 = t * t;
+    let t4 = t2 * t2;
+    let low = (p(0) + p(1) * t) + t2 * (p(2) + p(3) * t);
+    let high = (p(4) + p(5) * t) + t2 * p(6);
+    let poly = low + t4 * high;
     exponent.to_f32() + t * poly
 }
 
