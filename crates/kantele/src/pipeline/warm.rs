@@ -53,6 +53,11 @@ impl WarmWorkers {
         u64::try_from(self.epoch.elapsed().as_nanos()).unwrap_or(u64::MAX)
     }
 
+    /// The loops' deadline has passed.
+    fn deadline_passed(&self) -> bool {
+        self.now_ns() >= self.until_ns.load(SeqCst)
+    }
+
     /// Keeps the workers of `pool` awake for `period` from now (replacing an earlier deadline),
     /// starting a loop on every worker unless all of them run one.
     ///
@@ -84,15 +89,14 @@ impl WarmWorkers {
         }
         self.awake.fetch_add(1, SeqCst);
         loop {
-            if self.now_ns() >= self.until_ns.load(SeqCst) {
+            if self.deadline_passed() {
                 self.awake.fetch_sub(1, SeqCst);
-                // A deadline moved on after the check above, by a `keep_awake` that saw this
-                // loop still counted and started none: stay.
-                if self.now_ns() < self.until_ns.load(SeqCst) {
-                    self.awake.fetch_add(1, SeqCst);
-                    continue;
+                // Leave unless the deadline moved on after the check above, by a `keep_awake`
+                // that saw this loop still counted and started none.
+                if self.deadline_passed() {
+                    break;
                 }
-                break;
+                self.awake.fetch_add(1, SeqCst);
             }
             match rayon::yield_now() {
                 Some(rayon::Yield::Executed) => {}

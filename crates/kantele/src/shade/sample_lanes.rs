@@ -629,11 +629,21 @@ pub(super) fn log2_normal<L: Lanes>(x: L::F32) -> L::F32 {
     ];
     // Estrin's scheme: pairs `P[k] + P[k+1]·t` combined with t² and t⁴, five dependent steps
     // instead of Horner's twelve (the row's critical path runs through this).
-    let p = |k: usize| lanes.splat_f32(P[k]);
+    // Splats written out, not a closure: a closure may be compiled out of line, without the
+    // kernel's instruction set.
+    let [p0, p1, p2, p3, p4, p5, p6] = [
+        lanes.splat_f32(P[0]),
+        lanes.splat_f32(P[1]),
+        lanes.splat_f32(P[2]),
+        lanes.splat_f32(P[3]),
+        lanes.splat_f32(P[4]),
+        lanes.splat_f32(P[5]),
+        lanes.splat_f32(P[6]),
+    ];
     let t2 = t * t;
     let t4 = t2 * t2;
-    let low = (p(0) + p(1) * t) + t2 * (p(2) + p(3) * t);
-    let high = (p(4) + p(5) * t) + t2 * p(6);
+    let low = (p0 + p1 * t) + t2 * (p2 + p3 * t);
+    let high = (p4 + p5 * t) + t2 * p6;
     let poly = low + t4 * high;
     exponent.to_f32() + t * poly
 }
