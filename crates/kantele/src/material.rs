@@ -251,13 +251,8 @@ impl<'a> MaterialShader<'a> {
             return Vec3::ZERO;
         }
         let at = VaryingLayout::NORMAL;
-        // The direction alone: no perspective division (see `Fragment::varying_direction`).
-        let n = Vec3::new(
-            fragment.varying_direction(at),
-            fragment.varying_direction(at + 1),
-            fragment.varying_direction(at + 2),
-        )
-        .normalize_or_zero();
+        let v = fragment.varyings();
+        let n = Vec3::new(v[at], v[at + 1], v[at + 2]).normalize_or_zero();
         if self.material.double_sided && !fragment.front_facing {
             -n
         } else {
@@ -652,12 +647,7 @@ impl MaterialShader<'_> {
             return [lanes.splat_f32(0.0); 3];
         }
         let at = VaryingLayout::NORMAL;
-        // The direction alone: no perspective division (see `FragmentLanes::varying_direction`).
-        let n = [
-            f.varying_direction(at),
-            f.varying_direction(at + 1),
-            f.varying_direction(at + 2),
-        ];
+        let n = [f.varying(at), f.varying(at + 1), f.varying(at + 2)];
         let length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
         let rcp = lanes.splat_f32(1.0) / length2.sqrt();
         let usable = rcp

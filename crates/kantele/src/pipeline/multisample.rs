@@ -210,7 +210,6 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                     primitive_id: tri.primitive_id,
                     front_facing: tri.front_facing(),
                     weights,
-                    direction_weights: triangle.direction_weights(centre),
                     w,
                     interpolation: &interpolation,
                 };
