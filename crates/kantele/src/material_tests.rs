@@ -26,6 +26,26 @@ impl Shader for GeneralProgram<'_, '_> {
     }
 }
 
+/// A `size × size` sRGB texture (`size` a power of two up to 256) of red and green ramps and
+/// their XOR in blue, prepared for the lane sampler.
+fn pattern_texture(size: u32) -> Texture {
+    let step = 256 / size;
+    let rgba: Vec<u8> = (0..size * size)
+        .flat_map(|i| {
+            let (x, y) = (i % size, i / size);
+            [
+                (x * step) as u8,
+                (y * step) as u8,
+                ((x ^ y) * step) as u8,
+                255,
+            ]
+        })
+        .collect();
+    let texture = Texture::from_rgba8(size, size, &rgba, ColorSpace::Srgb).expect("texture");
+    texture.prepare_lane_sampling();
+    texture
+}
+
 /// The colour bits of a 96 × 64 frame of `mesh` drawn with `shader`.
 fn render<S: Shader<Vertex = StandardVertex>>(shader: &S, mesh: &Mesh) -> Vec<u32> {
     render_with(shader, mesh, RendererOptions::default())
@@ -116,22 +136,13 @@ fn a_constant_vertex_colour_is_shaded_exactly() {
     }
 }
 
-/// Every specialised lane program (untextured and textured, lit and unlit, with and without
-/// vertex colours) gives the bits of the general program it replaces, on a receding quad
 /// Small triangles (a jittered grid of cells about 3 × 3 pixels, each two triangles) leave
 /// most rows of their blocks nearly empty, so the textured program's kernel shades them
 /// packed ([`LaneProgram::PACKED_ROWS`]); the general program is never packed. Both give
 /// the same bits, on every instruction set.
 #[test]
 fn packed_rows_shade_as_rows_do() {
-    let rgba: Vec<u8> = (0..32u32 * 32)
-        .flat_map(|i| {
-            let (x, y) = (i % 32, i / 32);
-            [(x * 8) as u8, (y * 8) as u8, ((x ^ y) * 8) as u8, 255]
-        })
-        .collect();
-    let texture = Texture::from_rgba8(32, 32, &rgba, ColorSpace::Srgb).expect("texture");
-    texture.prepare_lane_sampling();
+    let texture = pattern_texture(32);
     let (columns, rows) = (32u32, 21u32);
     let mut jitter = 0x2545_f491u32;
     let mut next = move || {
@@ -199,17 +210,12 @@ fn packed_rows_shade_as_rows_do() {
     }
 }
 
+/// Every specialised lane program (untextured and textured, lit and unlit, with and without
+/// vertex colours) gives the bits of the general program it replaces, on a receding quad
 /// whose texture is magnified near the camera and minified (trilinear, repeating) far away.
 #[test]
 fn specialised_lane_programs_shade_as_the_general_one() {
-    let rgba: Vec<u8> = (0..64u32 * 64)
-        .flat_map(|i| {
-            let (x, y) = (i % 64, i / 64);
-            [(x * 4) as u8, (y * 4) as u8, ((x ^ y) * 4) as u8, 255]
-        })
-        .collect();
-    let texture = Texture::from_rgba8(64, 64, &rgba, ColorSpace::Srgb).expect("texture");
-    texture.prepare_lane_sampling();
+    let texture = pattern_texture(64);
     let sampler = TrilinearRepeat15::SAMPLER;
     let mesh = |colors: bool| Mesh {
         positions: vec![
