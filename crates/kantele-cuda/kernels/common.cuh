@@ -642,6 +642,9 @@ struct SceneView {
 struct FragmentInput {
     float varyings[NV];
     float weights_w;  // 1 / Σ q_i: the pixel's clip w
+    // Varyings 0..2 (the normal) with the direction weights, no perspective division
+    // (`FragmentLanes::varying_direction`).
+    float normal_direction[3];
 };
 
 // Perspective-correct varyings at a pixel (`DrawCall::raster`).
@@ -656,6 +659,15 @@ __device__ __forceinline__ void interpolate(const TriangleSetup& t, const float*
         in.varyings[k] = add(add(mul(w0, attrs[k]), mul(w1, attrs[NV + k])), mul(w2, attrs[2 * NV + k]));
     }
     in.weights_w = w;
+    // `relative_inv_w` and `TriangleLanes::direction_weights`: λ_i · (1/w_i) / max_j (1/w_j).
+    float scale = divide(1.0f, rmax(rmax(t.inv_w[0], t.inv_w[1]), t.inv_w[2]));
+    float d0 = mul(bary[0], mul(t.inv_w[0], scale));
+    float d1 = mul(bary[1], mul(t.inv_w[1], scale));
+    float d2 = mul(bary[2], mul(t.inv_w[2], scale));
+    for (int k = 0; k < 3; ++k) {
+        in.normal_direction[k] =
+            add(add(mul(d0, attrs[k]), mul(d1, attrs[NV + k])), mul(d2, attrs[2 * NV + k]));
+    }
 }
 
 // `Fragment::derivatives(index)`.
@@ -683,7 +695,14 @@ __device__ __forceinline__ void derivatives(const TriangleSetup& t, const float*
 
 __device__ __forceinline__ V3 material_normal(const DrawRecord& d, const FragmentInput& in,
                                               bool front_facing) {
-    V3 n = v3_normalize_or_zero({in.varyings[0], in.varyings[1], in.varyings[2]});
+    // `VaryingLayout::normal_from_direction`: the direction weights only where the draw reads
+    // no other varying (no texture coordinate, no vertex colour), as the CPU backend.
+    const u32 reads_other =
+        KANTELE_DRAW_TEXTURED | KANTELE_DRAW_EMISSIVE_TEXTURED | KANTELE_DRAW_VERTEX_COLORS;
+    V3 n = (d.flags & reads_other)
+               ? v3_normalize_or_zero({in.varyings[0], in.varyings[1], in.varyings[2]})
+               : v3_normalize_or_zero(
+                     {in.normal_direction[0], in.normal_direction[1], in.normal_direction[2]});
     if ((d.flags & KANTELE_DRAW_DOUBLE_SIDED) && !front_facing) return {-n.x, -n.y, -n.z};
     return n;
 }

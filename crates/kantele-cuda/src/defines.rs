@@ -12,7 +12,7 @@ use kantele::shade::texture::{Filter, MinFilter, Wrap};
 use crate::records::{
     filter_code, min_filter_code, pass_code, wrap_code, DrawIssue, DrawRecord, FrameUniforms,
     LevelRecord, SlotInfo, TextureRecord, DRAW_ALPHA_BLEND, DRAW_ALPHA_MASK, DRAW_DOUBLE_SIDED,
-    DRAW_EMISSIVE_TEXTURED, DRAW_FRONT_CW, DRAW_TEXTURED, DRAW_UNLIT,
+    DRAW_EMISSIVE_TEXTURED, DRAW_FRONT_CW, DRAW_TEXTURED, DRAW_UNLIT, DRAW_VERTEX_COLORS,
 };
 use kantele::backend::Pass;
 
@@ -77,6 +77,7 @@ pub fn defines() -> Vec<(String, String)> {
         ("KANTELE_DRAW_TEXTURED", DRAW_TEXTURED),
         ("KANTELE_DRAW_FRONT_CW", DRAW_FRONT_CW),
         ("KANTELE_DRAW_EMISSIVE_TEXTURED", DRAW_EMISSIVE_TEXTURED),
+        ("KANTELE_DRAW_VERTEX_COLORS", DRAW_VERTEX_COLORS),
         ("KANTELE_TRIANGLE_FRONT_FACING", TriangleSetup::FRONT_FACING),
         ("KANTELE_TRIANGLE_SWAPPED", TriangleSetup::SWAPPED),
     ] {

@@ -24,6 +24,9 @@ pub const DRAW_TEXTURED: u32 = 1 << 4;
 pub const DRAW_FRONT_CW: u32 = 1 << 5;
 /// `DrawRecord::flags`: the emission is multiplied by an emissive texture.
 pub const DRAW_EMISSIVE_TEXTURED: u32 = 1 << 6;
+/// `DrawRecord::flags`: the mesh has vertex colours (`COLOR_0`). With a texture, it decides
+/// how the normal is interpolated (`material_normal` in `kernels/common.cuh`).
+pub const DRAW_VERTEX_COLORS: u32 = 1 << 7;
 
 /// Kernel code of a [`Wrap`] mode.
 pub fn wrap_code(w: Wrap) -> u32 {
@@ -386,6 +389,9 @@ impl SceneArrays {
             if draw.front_face() == FrontFace::Cw {
                 flags |= DRAW_FRONT_CW;
             }
+            if scene.meshes[draw.mesh].colors.is_some() {
+                flags |= DRAW_VERTEX_COLORS;
+            }
             let mut record = DrawRecord {
                 model: draw.model.to_cols_array(),
                 normal_matrix: normal_matrix(&draw.model).to_cols_array(),
@@ -453,6 +459,7 @@ mod tests {
                 Mesh {
                     positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ONE],
                     normals: Some(vec![Vec3::Z; 4]),
+                    colors: Some(vec![Vec4::ONE; 4]),
                     indices: vec![0, 1, 2, 2, 1, 3],
                     material: 1,
                     ..Mesh::default()
@@ -515,7 +522,7 @@ mod tests {
         let d0 = a.draws[0];
         assert_eq!(
             d0.flags,
-            DRAW_DOUBLE_SIDED | DRAW_ALPHA_MASK | DRAW_TEXTURED
+            DRAW_DOUBLE_SIDED | DRAW_ALPHA_MASK | DRAW_TEXTURED | DRAW_VERTEX_COLORS
         );
         assert_eq!(
             (d0.alpha_cutoff, d0.sampler.wrap_s, d0.sampler.min_filter),

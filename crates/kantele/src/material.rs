@@ -82,6 +82,17 @@ impl VaryingLayout {
     /// First of the colour's four.
     const COLOR: usize = 5;
 
+    /// Whether the normal is interpolated as a direction only, without the perspective
+    /// division (`varying_direction`, then renormalised): where the draw reads no other
+    /// varying (no texture coordinate, no vertex colour), so its rows divide once, for the
+    /// normal's length, instead of twice. A draw that reads another varying divides for it
+    /// anyway and takes the perspective-correct normal: three more multiplications there
+    /// measured slower (see BENCHMARKS.md). The CUDA kernel's `material_normal` follows the
+    /// same rule.
+    fn normal_from_direction(self) -> bool {
+        !self.texcoord && !self.color
+    }
+
     /// Varyings written: up to the end of the last one read.
     fn count(self) -> usize {
         if self.color {
@@ -251,8 +262,18 @@ impl<'a> MaterialShader<'a> {
             return Vec3::ZERO;
         }
         let at = VaryingLayout::NORMAL;
-        let v = fragment.varyings();
-        let n = Vec3::new(v[at], v[at + 1], v[at + 2]).normalize_or_zero();
+        let n = if self.layout.normal_from_direction() {
+            // The direction alone: no perspective division (see `Fragment::varying_direction`).
+            Vec3::new(
+                fragment.varying_direction(at),
+                fragment.varying_direction(at + 1),
+                fragment.varying_direction(at + 2),
+            )
+        } else {
+            let v = fragment.varyings();
+            Vec3::new(v[at], v[at + 1], v[at + 2])
+        }
+        .normalize_or_zero();
         if self.material.double_sided && !fragment.front_facing {
             -n
         } else {
@@ -647,7 +668,17 @@ impl MaterialShader<'_> {
             return [lanes.splat_f32(0.0); 3];
         }
         let at = VaryingLayout::NORMAL;
-        let n = [f.varying(at), f.varying(at + 1), f.varying(at + 2)];
+        let n = if self.layout.normal_from_direction() {
+            // The direction alone: no perspective division (see
+            // `FragmentLanes::varying_direction`).
+            [
+                f.varying_direction(at),
+                f.varying_direction(at + 1),
+                f.varying_direction(at + 2),
+            ]
+        } else {
+            [f.varying(at), f.varying(at + 1), f.varying(at + 2)]
+        };
         let length2 = n[0] * n[0] + n[1] * n[1] + n[2] * n[2];
         let rcp = lanes.splat_f32(1.0) / length2.sqrt();
         let usable = rcp

@@ -293,3 +293,118 @@ fn specialised_lane_programs_shade_as_the_general_one() {
         }
     }
 }
+
+/// A built-in shader seen only through its per-fragment entry: the default `fragment_lanes`
+/// (each lane's scalar fragment, [`FragmentLanes::lane`]).
+struct ScalarFragments<'s, 'a>(&'s MaterialShader<'a>);
+
+impl Shader for ScalarFragments<'_, '_> {
+    type Vertex = StandardVertex;
+    fn varying_count(&self) -> usize {
+        self.0.varying_count()
+    }
+    fn vertex(&self, vertex: &StandardVertex, varyings: &mut [f32]) -> Vec4 {
+        self.0.vertex(vertex, varyings)
+    }
+    fn fragment(&self, fragment: &Fragment<'_>) -> Option<Vec4> {
+        self.0.fragment(fragment)
+    }
+}
+
+/// A draw that reads no other varying renormalises its normal from the direction alone
+/// (`varying_direction`, no perspective division), one with vertex colours from the
+/// perspective-correct normal: either way the scalar fragment and the lane programs take the
+/// same one, so a lit receding quad with a different normal at each vertex (and its normals
+/// pass) comes out the same, bit for bit, from both, on every instruction set; the normals
+/// written are unit vectors within rounding, and the two rules' normals agree within rounding
+/// (the same direction).
+#[test]
+fn scalar_fragments_and_lane_programs_take_the_same_normal_direction() {
+    let mesh = Mesh {
+        positions: vec![
+            Vec3::new(-1.0, -0.6, 0.5),
+            Vec3::new(1.0, -0.6, 0.5),
+            Vec3::new(1.0, 0.4, -8.0),
+            Vec3::new(-1.0, 0.4, -8.0),
+        ],
+        normals: Some(vec![
+            Vec3::new(0.0, 1.0, 0.1),
+            Vec3::new(0.3, 1.0, 0.0),
+            Vec3::new(0.0, 1.0, -0.4),
+            Vec3::new(-0.2, 0.8, 0.0),
+        ]),
+        indices: vec![0, 1, 2, 0, 2, 3],
+        ..Mesh::default()
+    };
+    let view_projection = Mat4::perspective_rh(1.0, 1.5, 0.1, 20.0)
+        * Mat4::look_at_rh(Vec3::new(0.0, 0.6, 1.6), Vec3::new(0.0, 0.0, -2.0), Vec3::Y);
+    let lighting = Lighting {
+        to_light: Vec3::new(0.3, 0.9, 0.3).normalize(),
+        light_color: Vec3::new(1.0, 0.95, 0.9),
+        ambient: 0.2,
+    };
+    let material = Material {
+        base_color_factor: Vec4::new(0.9, 0.8, 0.7, 1.0),
+        ..Material::default()
+    };
+    // The normals pass of the last instruction set, without and with vertex colours.
+    let mut normals_by_rule: [Vec<u32>; 2] = Default::default();
+    for (pass, vertex_colors) in [
+        (Pass::Color, false),
+        (Pass::Color, true),
+        (Pass::Normals, false),
+        (Pass::Normals, true),
+    ] {
+        let shader = MaterialShader::new(
+            Mat4::IDENTITY,
+            view_projection,
+            lighting,
+            &material,
+            None,
+            pass,
+            (1, 1),
+        )
+        .with_vertex_colors(vertex_colors);
+        for isa in Isa::supported() {
+            let options = RendererOptions {
+                isa: Some(isa),
+                ..RendererOptions::default()
+            };
+            let lanes = render_with(&shader, &mesh, options);
+            let scalar = render_with(&ScalarFragments(&shader), &mesh, options);
+            let drawn = lanes
+                .chunks_exact(4)
+                .filter(|c| c[2] != 0.3f32.to_bits())
+                .count();
+            assert!(drawn > 1000, "{pass:?}, {isa:?}: {drawn} pixels drawn");
+            assert!(
+                lanes == scalar,
+                "{pass:?}, {isa:?}: scalar and lanes differ"
+            );
+            if pass == Pass::Normals {
+                for c in lanes.chunks_exact(4).filter(|c| c[2] != 0.3f32.to_bits()) {
+                    let n = Vec3::new(
+                        f32::from_bits(c[0]),
+                        f32::from_bits(c[1]),
+                        f32::from_bits(c[2]),
+                    );
+                    assert!((n.length() - 1.0).abs() < 1e-6, "{isa:?}: normal {n}");
+                }
+                normals_by_rule[usize::from(vertex_colors)] = lanes;
+            }
+        }
+    }
+    let [direction, perspective] = normals_by_rule;
+    assert_eq!(direction.len(), perspective.len());
+    let mut differing = 0;
+    for (d, p) in direction.iter().zip(&perspective) {
+        let (d, p) = (f32::from_bits(*d), f32::from_bits(*p));
+        assert!((d - p).abs() <= 1e-5, "normal component {d} against {p}");
+        differing += usize::from(d != p);
+    }
+    // The two rules are different computations (else the first would not be needed).
+    assert!(
+        differing > 0,
+        "the direction and perspective normals are identical"
+    );
+}

@@ -227,6 +227,8 @@ pub(super) struct TriangleLanes<L: Lanes> {
     z: [L::F32; 3],
     z_range: [L::F32; 2],
     inv_w: [L::F32; 3],
+    /// `1/w` per vertex over the largest of the three ([`relative_inv_w`]).
+    inv_w_relative: [L::F32; 3],
     /// Sub-pixel offsets of the eight lanes' centres from lane 0's.
     lane_offset: L::I32,
     /// 0 and 1 in every lane.
@@ -255,6 +257,14 @@ impl<L: Lanes> TriangleLanes<L> {
                 lanes.splat_f32(tri.inv_w[1]),
                 lanes.splat_f32(tri.inv_w[2]),
             ],
+            inv_w_relative: {
+                let r = relative_inv_w(tri.inv_w);
+                [
+                    lanes.splat_f32(r[0]),
+                    lanes.splat_f32(r[1]),
+                    lanes.splat_f32(r[2]),
+                ]
+            },
             lane_offset: lanes
                 .lane_index()
                 .shl::<{ crate::fixed::SUBPIXEL_BITS as i32 }>(),
@@ -319,6 +329,7 @@ impl<L: Lanes> TriangleLanes<L> {
     ) -> FragmentLanes<'i, L> {
         let (weights, w) = self.perspective_weights(bary);
         FragmentLanes {
+            direction_weights: self.direction_weights(bary),
             lanes: self.zero.lanes(),
             x: x as u32,
             y: y as u32,
@@ -332,6 +343,14 @@ impl<L: Lanes> TriangleLanes<L> {
         }
     }
 
+    /// Weights proportional to the perspective-correct ones, without their division
+    /// ([`FragmentLanes::varying_direction`]): `λ_i · r_i` with `r` from [`relative_inv_w`].
+    #[inline(always)]
+    pub(super) fn direction_weights(&self, [l0, l1, l2]: [L::F32; 3]) -> [L::F32; 3] {
+        let r = self.inv_w_relative;
+        [l0 * r[0], l1 * r[1], l2 * r[2]]
+    }
+
     /// Perspective-correct weights and `w` from screen-space barycentrics.
     #[inline(always)]
     pub(super) fn perspective_weights(&self, [l0, l1, l2]: [L::F32; 3]) -> ([L::F32; 3], L::F32) {
@@ -339,6 +358,18 @@ impl<L: Lanes> TriangleLanes<L> {
         let w = self.one / (q[0] + q[1] + q[2]);
         ([q[0] * w, q[1] * w, q[2] * w], w)
     }
+}
+
+/// A triangle's `1/w` per vertex divided by the largest of the three (each in `(0, 1]`, the
+/// largest exactly 1). Screen-space barycentrics times these are proportional to the
+/// perspective-correct weights (the factor is the smallest vertex `w` over the pixel's `w`), at
+/// most 1 and summing to at least the ratio of the smallest to the largest vertex `w`, so that
+/// a direction interpolated with them ([`FragmentLanes::varying_direction`]) neither overflows
+/// nor underflows where the perspective-correct one would not. Non-finite where `1/w` is (not
+/// for a triangle that passed clipping); the shader's normalisation then gives zero.
+pub(crate) fn relative_inv_w(inv_w: [f32; 3]) -> [f32; 3] {
+    let scale = 1.0 / inv_w[0].max(inv_w[1]).max(inv_w[2]);
+    [inv_w[0] * scale, inv_w[1] * scale, inv_w[2] * scale]
 }
 
 /// A tile's deferred clear ([`DeferredClear`]) splatted across the lanes.
@@ -710,5 +741,24 @@ impl RowRules<'_> {
                     .store(&mut rows.depth[at..at + 8]);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::relative_inv_w;
+
+    /// The largest `1/w` becomes 1 exactly, the others keep their ratios to it, and far-apart
+    /// values neither overflow nor vanish.
+    #[test]
+    fn relative_inv_w_scales_the_largest_to_one() {
+        assert_eq!(relative_inv_w([0.5, 2.0, 1.0]), [0.25, 1.0, 0.5]);
+        assert_eq!(relative_inv_w([4.0, 4.0, 4.0]), [1.0, 1.0, 1.0]);
+        let r = relative_inv_w([1e-20, 1.0, 1e20]);
+        assert_eq!(r[2], 1.0);
+        assert!(
+            r[0] > 0.0 && r[1] > 0.0 && r.iter().all(|v| v.is_finite()),
+            "{r:?}"
+        );
     }
 }

@@ -210,6 +210,7 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                     primitive_id: tri.primitive_id,
                     front_facing: tri.front_facing(),
                     weights,
+                    direction_weights: triangle.direction_weights(centre),
                     w,
                     interpolation: &interpolation,
                 };

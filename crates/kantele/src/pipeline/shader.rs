@@ -179,6 +179,8 @@ pub struct Fragment<'a> {
     interpolation: &'a Interpolation<'a>,
     /// Perspective weights of the three vertices at this pixel (sum to 1).
     weights: [f32; 3],
+    /// Weights proportional to `weights` ([`Fragment::varying_direction`]).
+    direction_weights: [f32; 3],
     /// `1 / Σ(λ_i / w_i)`: the pixel's clip w.
     w: f32,
 }
@@ -194,6 +196,16 @@ impl Fragment<'_> {
     #[inline]
     pub fn varying(&self, index: usize) -> f32 {
         self.varyings[index]
+    }
+
+    /// Varying `index` times a positive factor that is the same for every varying of this
+    /// fragment, without the perspective division: for values whose direction is all that
+    /// counts (a normal about to be normalised). See [`FragmentLanes::varying_direction`],
+    /// whose lanes it equals bit for bit.
+    #[inline]
+    pub fn varying_direction(&self, index: usize) -> f32 {
+        self.interpolation
+            .interpolate(index, self.direction_weights)
     }
 
     /// Perspective-correct barycentric weights of the triangle's vertices at this pixel.
@@ -269,8 +281,9 @@ pub(crate) struct Interpolation<'a> {
 }
 
 impl Interpolation<'_> {
-    /// Varying `index` from perspective-correct `weights`: `Σ weight_i · a_i`, or the vertices'
-    /// common value where every varying is [`Interpolation::constant`].
+    /// Varying `index` from `weights` (perspective-correct, or proportional to them):
+    /// `Σ weight_i · a_i`, or the vertices' common value where every varying is
+    /// [`Interpolation::constant`].
     #[inline(always)]
     fn interpolate(&self, index: usize, weights: [f32; 3]) -> f32 {
         let a = self.attrs[index];
@@ -302,6 +315,10 @@ pub struct FragmentLanes<'a, L: Lanes> {
     /// constant triangles computes them too; where its program reads only varyings, the
     /// compiler removes them (and their division) as unused.
     pub(crate) weights: [L::F32; 3],
+    /// Screen-space barycentrics times each vertex's `1/w` over the largest of the three: the
+    /// perspective-correct weights times the positive factor `w_min / w`, with no division
+    /// (see [`FragmentLanes::varying_direction`]).
+    pub(crate) direction_weights: [L::F32; 3],
     pub(crate) w: L::F32,
     pub(crate) interpolation: &'a Interpolation<'a>,
 }
@@ -309,6 +326,7 @@ pub struct FragmentLanes<'a, L: Lanes> {
 /// The per-lane values [`FragmentLanes::lane`] reads, extracted once per row.
 pub(crate) struct PerLane {
     weights: [[f32; 8]; 3],
+    direction_weights: [[f32; 8]; 3],
     w: [f32; 8],
     depth: [f32; 8],
 }
@@ -318,15 +336,32 @@ impl<'a, L: Lanes> FragmentLanes<'a, L> {
     /// whose every varying has the same bits at its three vertices, exactly that value.
     #[inline(always)]
     pub fn varying(&self, index: usize) -> L::F32 {
+        self.interpolate(index, self.weights)
+    }
+
+    /// Varying `index` times a positive factor per lane that is the same for every varying of
+    /// the lane (`w_min / w`, the triangle's smallest vertex `w` over the lane's clip `w`; 1 on
+    /// a constant triangle, where it is the value exactly), for values whose direction is all
+    /// that counts: a normal about to be normalised. It needs no perspective division, so a
+    /// program that reads nothing else has none per row.
+    #[inline(always)]
+    pub fn varying_direction(&self, index: usize) -> L::F32 {
+        self.interpolate(index, self.direction_weights)
+    }
+
+    /// `Σ weight_i · a_i` for varying `index`, or the vertices' common value on a constant
+    /// triangle (as [`Interpolation::interpolate`] per lane).
+    #[inline(always)]
+    fn interpolate(&self, index: usize, weights: [L::F32; 3]) -> L::F32 {
         let a = self.interpolation.attrs[index];
         let lanes = self.lanes;
         // A compile-time constant in the 1× kernel (compiled once more for constant triangles).
         if self.interpolation.constant {
             return lanes.splat_f32(a[0]);
         }
-        self.weights[0] * lanes.splat_f32(a[0])
-            + self.weights[1] * lanes.splat_f32(a[1])
-            + self.weights[2] * lanes.splat_f32(a[2])
+        weights[0] * lanes.splat_f32(a[0])
+            + weights[1] * lanes.splat_f32(a[1])
+            + weights[2] * lanes.splat_f32(a[2])
     }
 
     /// Perspective-correct barycentric weights of the triangle's vertices (sum to 1).
@@ -365,6 +400,11 @@ impl<'a, L: Lanes> FragmentLanes<'a, L> {
                 self.weights[1].to_array(),
                 self.weights[2].to_array(),
             ],
+            direction_weights: [
+                self.direction_weights[0].to_array(),
+                self.direction_weights[1].to_array(),
+                self.direction_weights[2].to_array(),
+            ],
             w: self.w.to_array(),
             depth: self.depth.to_array(),
         }
@@ -398,6 +438,11 @@ impl<'a, L: Lanes> FragmentLanes<'a, L> {
             varyings: &varyings[..n],
             interpolation: ip,
             weights,
+            direction_weights: [
+                per_lane.direction_weights[0][k],
+                per_lane.direction_weights[1][k],
+                per_lane.direction_weights[2][k],
+            ],
             w: per_lane.w[k],
         }
     }
