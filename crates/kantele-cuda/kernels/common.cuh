@@ -642,9 +642,7 @@ struct SceneView {
 struct FragmentInput {
     float varyings[NV];
     float weights_w;  // 1 / Σ q_i: the pixel's clip w
-    // Varyings 0..2 (the normal) with the direction weights, no perspective division
-    // (`FragmentLanes::varying_direction`).
-    float normal_direction[3];
+    float bary[3];    // screen-space barycentrics (for `material_normal`'s direction weights)
 };
 
 // Perspective-correct varyings at a pixel (`DrawCall::raster`).
@@ -659,15 +657,7 @@ __device__ __forceinline__ void interpolate(const TriangleSetup& t, const float*
         in.varyings[k] = add(add(mul(w0, attrs[k]), mul(w1, attrs[NV + k])), mul(w2, attrs[2 * NV + k]));
     }
     in.weights_w = w;
-    // `relative_inv_w` and `TriangleLanes::direction_weights`: λ_i · (1/w_i) / max_j (1/w_j).
-    float scale = divide(1.0f, rmax(rmax(t.inv_w[0], t.inv_w[1]), t.inv_w[2]));
-    float d0 = mul(bary[0], mul(t.inv_w[0], scale));
-    float d1 = mul(bary[1], mul(t.inv_w[1], scale));
-    float d2 = mul(bary[2], mul(t.inv_w[2], scale));
-    for (int k = 0; k < 3; ++k) {
-        in.normal_direction[k] =
-            add(add(mul(d0, attrs[k]), mul(d1, attrs[NV + k])), mul(d2, attrs[2 * NV + k]));
-    }
+    for (int i = 0; i < 3; ++i) in.bary[i] = bary[i];
 }
 
 // `Fragment::derivatives(index)`.
@@ -693,24 +683,37 @@ __device__ __forceinline__ void derivatives(const TriangleSetup& t, const float*
     }
 }
 
-__device__ __forceinline__ V3 material_normal(const DrawRecord& d, const FragmentInput& in,
-                                              bool front_facing) {
-    // `VaryingLayout::normal_from_direction`: the direction weights only where the draw reads
-    // no other varying (no texture coordinate, no vertex colour), as the CPU backend.
+// `MaterialShader::normal`: the interpolated normal, renormalised, flipped on back faces of a
+// double-sided draw. `VaryingLayout::normal_from_direction`, as the CPU backend: a draw that
+// reads no other varying (no texture coordinate, no vertex colour) interpolates it with the
+// direction weights (`relative_inv_w`, `TriangleLanes::direction_weights`:
+// λ_i · (1/w_i) / max_j (1/w_j), no perspective division), every other draw takes the
+// perspective-correct varyings.
+__device__ __forceinline__ V3 material_normal(const DrawRecord& d, const TriangleSetup& t,
+                                              const float* attrs, const FragmentInput& in) {
     const u32 reads_other =
         KANTELE_DRAW_TEXTURED | KANTELE_DRAW_EMISSIVE_TEXTURED | KANTELE_DRAW_VERTEX_COLORS;
-    V3 n = (d.flags & reads_other)
-               ? v3_normalize_or_zero({in.varyings[0], in.varyings[1], in.varyings[2]})
-               : v3_normalize_or_zero(
-                     {in.normal_direction[0], in.normal_direction[1], in.normal_direction[2]});
+    float v[3] = {in.varyings[0], in.varyings[1], in.varyings[2]};
+    if (!(d.flags & reads_other)) {
+        float scale = divide(1.0f, rmax(rmax(t.inv_w[0], t.inv_w[1]), t.inv_w[2]));
+        float d0 = mul(in.bary[0], mul(t.inv_w[0], scale));
+        float d1 = mul(in.bary[1], mul(t.inv_w[1], scale));
+        float d2 = mul(in.bary[2], mul(t.inv_w[2], scale));
+        for (int k = 0; k < 3; ++k) {
+            v[k] = add(add(mul(d0, attrs[k]), mul(d1, attrs[NV + k])), mul(d2, attrs[2 * NV + k]));
+        }
+    }
+    V3 n = v3_normalize_or_zero({v[0], v[1], v[2]});
+    bool front_facing = (t.flags & KANTELE_TRIANGLE_FRONT_FACING) != 0;
     if ((d.flags & KANTELE_DRAW_DOUBLE_SIDED) && !front_facing) return {-n.x, -n.y, -n.z};
     return n;
 }
 
 __device__ __forceinline__ V4 auxiliary(const FrameUniforms& f, const DrawRecord& d,
-                                        const FragmentInput& in, const TriangleSetup& t) {
+                                        const TriangleSetup& t, const float* attrs,
+                                        const FragmentInput& in) {
     if (f.pass == KANTELE_PASS_NORMALS) {
-        V3 n = material_normal(d, in, (t.flags & KANTELE_TRIANGLE_FRONT_FACING) != 0);
+        V3 n = material_normal(d, t, attrs, in);
         return {n.x, n.y, n.z, 1.0f};
     }
     return {(float)d.node_id, add((float)t.primitive_id, 1.0f), (float)d.draw_id, 1.0f};
@@ -734,7 +737,7 @@ __device__ bool shade_fragment(const FrameUniforms& f, const SceneView& s, const
     const DrawRecord& d = s.draws[t.draw];
     bool needs_alpha = (d.flags & (KANTELE_DRAW_ALPHA_MASK | KANTELE_DRAW_ALPHA_BLEND)) != 0;
     if (f.pass != KANTELE_PASS_COLOR && !needs_alpha) {
-        out = auxiliary(f, d, in, t);
+        out = auxiliary(f, d, t, attrs, in);
         return true;
     }
     V4 color = {in.varyings[5], in.varyings[6], in.varyings[7], in.varyings[8]};
@@ -749,7 +752,7 @@ __device__ bool shade_fragment(const FrameUniforms& f, const SceneView& s, const
         alpha = base.w;
     }
     if (f.pass != KANTELE_PASS_COLOR) {
-        out = auxiliary(f, d, in, t);
+        out = auxiliary(f, d, t, attrs, in);
         return true;
     }
     // Emission (`MaterialShader::emissive`): factor × emissive texture, added after lighting
@@ -763,7 +766,7 @@ __device__ bool shade_fragment(const FrameUniforms& f, const SceneView& s, const
         out = {add(base.x, e.x), add(base.y, e.y), add(base.z, e.z), alpha};
         return true;
     }
-    V3 n = material_normal(d, in, (t.flags & KANTELE_TRIANGLE_FRONT_FACING) != 0);
+    V3 n = material_normal(d, t, attrs, in);
     float n_dot_l = rmax(v3_dot(n, {f.to_light[0], f.to_light[1], f.to_light[2]}), 0.0f);
     float k = mul(sub(1.0f, f.ambient), n_dot_l);
     V3 light = {add(f.ambient, mul(k, f.light_color[0])), add(f.ambient, mul(k, f.light_color[1])),
