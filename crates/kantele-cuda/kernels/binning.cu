@@ -60,7 +60,8 @@ extern "C" __global__ void kantele_bin_fill(FrameUniforms f, const TriangleSetup
     bin_walk<true>(f, setups, slots, cursor, bins, nullptr);
 }
 
-// Each tile's first bin entry: `tile_start[t] = offsets[t * chunk_count]`, and
+// Each tile's first bin entry: `tile_start[t] = offsets[t * chunk_count]` (launched before
+// `kantele_bin_fill`, which advances `offsets` as its cursors), and
 // `tile_start[tiles] = min(total, bin_capacity)` (the raster does not run on overflow).
 extern "C" __global__ void kantele_bin_ranges(FrameUniforms f, const u32* offsets,
                                               const u64* status, u32* tile_start) {

@@ -225,8 +225,10 @@ pub fn tiled_frame(shape: &FrameShape, resolve_rgba8: bool) -> Vec<Step> {
     for level in (0..levels.len().saturating_sub(1)).rev() {
         steps.extend(launch(Kernel::ScanAdd(level), levels[level], SCAN_THREADS));
     }
-    steps.extend(launch(Kernel::BinFill, warp_threads, THREADS));
+    // The ranges read the scanned offsets before the fill advances them as its cursors
+    // (after the fill, tile t's first entry would read as tile t + 1's).
     steps.extend(launch(Kernel::BinRanges, shape.tiles() as u64 + 1, THREADS));
+    steps.extend(launch(Kernel::BinFill, warp_threads, THREADS));
     steps.push(Step::Mark(Stage::Binning));
     // One block per tile.
     steps.extend(launch(
@@ -418,8 +420,8 @@ mod tests {
                 Kernel::ScanBlocks(0),
                 Kernel::ScanBlocks(1),
                 Kernel::ScanAdd(0),
-                Kernel::BinFill,
                 Kernel::BinRanges,
+                Kernel::BinFill,
                 Kernel::Raster,
             ]
         );
