@@ -126,6 +126,11 @@ pub trait Backend {
     fn isa(&self) -> String {
         "-".to_string()
     }
+    /// How colour frames are stored: `"f32"` (linear floats, the default), `"srgb8"` (8-bit
+    /// sRGB, blending in linear space) or `"rgba8"` (8-bit linear).
+    fn target(&self) -> String {
+        "f32".to_string()
+    }
     /// Restricts the following frames to the pixel rows `rows` of their view (a render
     /// region; `None`: whole frames again). The viewport stays the whole view's, so a band is
     /// bit-identical to the same rows of the whole frame; [`Backend::read_frame`] returns only

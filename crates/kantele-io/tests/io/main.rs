@@ -17,4 +17,5 @@ mod isa_identical;
 mod obj_files;
 mod pose;
 mod reference_scenes;
+mod srgb8_target;
 mod valid_files;

@@ -9,6 +9,7 @@ use crate::material::{Lighting, MaterialShader, StandardVertex};
 use crate::multisample::SampleCount;
 use crate::pipeline::{Indices, RenderState, Renderer, RendererOptions};
 use crate::raster::Strategy;
+use crate::rop::TargetFormat;
 use crate::scene::{Mesh, Scene, Topology};
 use crate::stats::FrameStats;
 
@@ -38,6 +39,8 @@ pub struct CpuBackend {
     renderer: Renderer,
     /// Samples per pixel of colour frames.
     samples: SampleCount,
+    /// The target format of colour frames (normals and ids are always drawn into `f32`).
+    target: TargetFormat,
     scene: Option<(Arc<Scene>, Vec<PreparedMesh>)>,
     /// The rows frames are restricted to (`None`: whole frames).
     region: Option<std::ops::Range<u32>>,
@@ -49,6 +52,7 @@ impl CpuBackend {
         Ok(Self {
             renderer: Renderer::new(1, 1, options)?,
             samples: options.samples,
+            target: options.target,
             scene: None,
             region: None,
         })
@@ -93,6 +97,10 @@ impl Backend for CpuBackend {
         self.renderer.isa().name().to_string()
     }
 
+    fn target(&self) -> String {
+        self.target.name().to_string()
+    }
+
     /// Restricts frames to rows `rows` of their view ([`Renderer::resize_band`]): only those
     /// tiles are allocated, binned and drawn. A region past a frame's height is an error of
     /// that frame's [`Backend::render`].
@@ -131,15 +139,17 @@ impl Backend for CpuBackend {
         let Some((scene, meshes)) = &self.scene else {
             return Err(RenderError::InvalidScene("no scene loaded".into()));
         };
-        // Ids and normals are never averaged: those passes render at 1×.
-        let samples = match view.pass {
-            Pass::Color => self.samples,
-            Pass::Normals | Pass::Ids => SampleCount::X1,
+        // Ids and normals are never averaged nor quantised: those passes render at 1× into
+        // `f32`.
+        let (samples, target) = match view.pass {
+            Pass::Color => (self.samples, self.target),
+            Pass::Normals | Pass::Ids => (SampleCount::X1, TargetFormat::LinearF32),
         };
-        if samples != self.renderer.samples() {
+        if (samples, target) != (self.renderer.samples(), self.renderer.target_format()) {
             // Re-created at the new size (the 1 × 1 target first keeps the switch cheap).
             self.renderer.resize(1, 1)?;
             self.renderer.set_samples(samples)?;
+            self.renderer.set_target_format(target)?;
         }
         let rows = self.region.clone().unwrap_or(0..view.height);
         self.renderer.resize_band(view.width, view.height, rows)?;

@@ -7,8 +7,6 @@
 //! instruction set (no fused multiply-add), so the scalar build — the readable reference — and
 //! the SIMD builds give the same picture bit for bit.
 
-use rayon::prelude::*;
-
 use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::draw::{DrawCall, DrawJob};
 use super::geometry::GeometryOutput;
@@ -80,13 +78,13 @@ pub(super) fn raster_tiles(
         );
     }
     let grid = *framebuffer.grid();
-    framebuffer
-        .tiles_mut()
-        .par_iter_mut()
-        .enumerate()
-        .with_max_len(TILES_PER_PIECE)
+    framebuffer.par_tiles(
+        TILES_PER_PIECE,
+        isa,
+        |tile_index| !bins.tile_is_empty(tile_index),
         // The storage for packed rows is made once per piece of work (2 KB on the stack).
-        .map_init(PackedRows::new, |packed, (tile_index, tile)| {
+        PackedRows::new,
+        |packed, tile_index, tile| {
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();
             let mut coverage = BlockCoverage::default();
@@ -117,8 +115,9 @@ pub(super) fn raster_tiles(
                 counters = RasterCounters::sum(counters, c);
             }
             counters
-        })
-        .reduce(RasterCounters::default, RasterCounters::sum)
+        },
+        RasterCounters::sum,
+    )
 }
 
 /// The triangles of tile `tile_index`'s bin in submission order, numbered from 0. When one is

@@ -45,7 +45,7 @@ use crate::error::RenderError;
 use crate::multisample::SampleCount;
 use crate::raster::bin::TileBins;
 use crate::raster::Strategy;
-use crate::rop::Framebuffer;
+use crate::rop::{Framebuffer, TargetFormat};
 use crate::setup::{PixelRect, Viewport};
 use crate::simd::Isa;
 use crate::stats::{FrameStats, FrameStop};
@@ -68,6 +68,10 @@ pub struct RendererOptions {
     /// Samples per pixel of the target (multisample antialiasing; see
     /// [`crate::multisample`]). The default, 1×, is the single-sample path.
     pub samples: SampleCount,
+    /// How the target stores colour: linear `f32` (the default, exact) or 8-bit sRGB (a
+    /// quarter of the colour memory; the same 8-bit picture for a frame that starts with a
+    /// clear, see [`TargetFormat`]).
+    pub target: TargetFormat,
 }
 
 /// The CPU renderer: owns the framebuffer and the worker threads.
@@ -102,8 +106,16 @@ impl Renderer {
                 backend: "cpu".into(),
                 message: format!("cannot start worker threads: {e}"),
             })?;
+        let framebuffer = Framebuffer::band(
+            width,
+            height,
+            0..height,
+            options.samples,
+            options.target,
+            pool.current_num_threads(),
+        )?;
         Ok(Self {
-            framebuffer: Framebuffer::new(width, height, options.samples)?,
+            framebuffer,
             pool,
             strategy: options.strategy,
             isa: resolve_isa(options.isa),
@@ -141,10 +153,37 @@ impl Renderer {
         }
         let fb = &self.framebuffer;
         if (width, height, rows.clone()) != (fb.width(), fb.height(), fb.rows()) {
-            let samples = fb.samples();
-            // Free the old target first: two big targets need not fit at once.
-            self.framebuffer = Framebuffer::new(1, 1, samples)?;
-            self.framebuffer = Framebuffer::band(width, height, rows, samples)?;
+            self.rebuild_target(width, height, rows, fb.samples(), fb.format())?;
+        }
+        Ok(())
+    }
+
+    /// Replaces the target with a new one (contents undefined).
+    fn rebuild_target(
+        &mut self,
+        width: u32,
+        height: u32,
+        rows: std::ops::Range<u32>,
+        samples: SampleCount,
+        format: TargetFormat,
+    ) -> Result<(), RenderError> {
+        // Free the old target first: two big targets need not fit at once.
+        self.framebuffer = Framebuffer::new(1, 1, SampleCount::X1)?;
+        let workers = self.pool.current_num_threads();
+        self.framebuffer = Framebuffer::band(width, height, rows, samples, format, workers)?;
+        Ok(())
+    }
+
+    /// How the target stores colour.
+    pub fn target_format(&self) -> TargetFormat {
+        self.framebuffer.format()
+    }
+
+    /// Changes how the target stores colour (contents become undefined: clear before drawing).
+    pub fn set_target_format(&mut self, format: TargetFormat) -> Result<(), RenderError> {
+        let fb = &self.framebuffer;
+        if format != fb.format() {
+            self.rebuild_target(fb.width(), fb.height(), fb.rows(), fb.samples(), format)?;
         }
         Ok(())
     }
@@ -158,11 +197,9 @@ impl Renderer {
     /// error when the multisampled target would be too large (see
     /// [`crate::multisample::MAX_MULTISAMPLE_TARGET_BYTES`]).
     pub fn set_samples(&mut self, samples: SampleCount) -> Result<(), RenderError> {
-        if samples != self.framebuffer.samples() {
-            let fb = &self.framebuffer;
-            let (width, height, rows) = (fb.width(), fb.height(), fb.rows());
-            self.framebuffer = Framebuffer::new(1, 1, samples)?;
-            self.framebuffer = Framebuffer::band(width, height, rows, samples)?;
+        let fb = &self.framebuffer;
+        if samples != fb.samples() {
+            self.rebuild_target(fb.width(), fb.height(), fb.rows(), samples, fb.format())?;
         }
         Ok(())
     }

@@ -15,8 +15,6 @@
 //! the block (centre and samples), and the tile's bound is refreshed over every plane, so a
 //! block or tile is skipped only when every sample in it would fail.
 
-use rayon::prelude::*;
-
 use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::draw::{DrawCall, DrawJob};
 use super::fragment::{binned_triangles, RasterCounters, TriangleLanes, TILES_PER_PIECE};
@@ -44,12 +42,12 @@ pub(super) fn raster_tiles_multisampled(
 ) -> RasterCounters {
     let grid = *framebuffer.grid();
     let samples = framebuffer.samples();
-    framebuffer
-        .tiles_mut()
-        .par_iter_mut()
-        .enumerate()
-        .with_max_len(TILES_PER_PIECE)
-        .map(|(tile_index, tile)| {
+    framebuffer.par_tiles(
+        TILES_PER_PIECE,
+        isa,
+        |tile_index| !bins.tile_is_empty(tile_index),
+        || (),
+        |(), tile_index, tile| {
             let rect = grid.tile_rect(tile_index);
             let mut counters = RasterCounters::default();
             let mut coverage = SampleCoverage::default();
@@ -78,8 +76,9 @@ pub(super) fn raster_tiles_multisampled(
                 counters = RasterCounters::sum(counters, c);
             }
             counters
-        })
-        .reduce(RasterCounters::default, RasterCounters::sum)
+        },
+        RasterCounters::sum,
+    )
 }
 
 /// Shades one triangle's covered samples in one multisampled tile with the instruction set

@@ -190,6 +190,14 @@ impl TileBins {
             .flat_map(move |bins| bins[tile].iter().copied())
     }
 
+    /// Whether no triangle touches `tile`.
+    #[inline]
+    pub fn tile_is_empty(&self, tile: usize) -> bool {
+        self.chunks[..self.chunk_count]
+            .iter()
+            .all(|bins| bins[tile].is_empty())
+    }
+
     /// Number of tiles binned for.
     pub fn tile_count(&self) -> usize {
         self.tile_count

@@ -1,27 +1,102 @@
 //! Output merger: depth test, blending, and the tiled framebuffer they write to.
 //!
-//! Colour is kept as linear `f32` RGBA (so blending happens in linear space and nothing is lost
-//! before the final encode); it is converted to 8-bit — sRGB-encoded or not — when read back.
-//! Storage is tile-major: each 64 × 64 tile owns its colour and depth, so tiles can be
-//! rasterized in parallel without sharing memory.
+//! The default target ([`TargetFormat::LinearF32`]) keeps colour as linear `f32` RGBA (so
+//! blending happens in linear space and nothing is lost before the final encode); it is
+//! converted to 8-bit — sRGB-encoded or not — when read back. The 8-bit target
+//! ([`TargetFormat::Srgb8`], [`srgb8`]) stores 8-bit sRGB between frames and draws each tile
+//! in a worker's `f32` tile. Storage is tile-major: each 64 × 64 tile owns its colour and
+//! depth, so tiles can be rasterized in parallel without sharing memory.
+
+use std::sync::Mutex;
 
 use glam::Vec4;
+use rayon::prelude::*;
 
 pub use crate::state::{BlendMode, DepthFunc};
 
+pub mod srgb8;
 mod tile;
 
+pub use srgb8::Srgb8Tile;
 pub use tile::{BlockRows, DeferredClear, TileBuffer, BLOCK_SPAN};
+
+use crate::simd::Isa;
+
+/// How a target stores colour between frames.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum TargetFormat {
+    /// Linear `f32` RGBA, 16 bytes a sample: exact; encoded to 8-bit only when read back.
+    #[default]
+    LinearF32,
+    /// 8-bit RGBA, red, green and blue sRGB-encoded, 4 bytes a sample (OpenGL's
+    /// `GL_SRGB8_ALPHA8` with `GL_FRAMEBUFFER_SRGB`). Within a frame each tile is drawn and
+    /// blended in linear `f32`, then encoded exactly, so a frame that starts with a clear reads
+    /// back as the same 8-bit picture as [`TargetFormat::LinearF32`] (see [`srgb8`]).
+    Srgb8,
+}
+
+impl TargetFormat {
+    /// Every format.
+    pub const ALL: [TargetFormat; 2] = [TargetFormat::LinearF32, TargetFormat::Srgb8];
+
+    /// The name `kantele --target` and `bench` use: `f32` or `srgb8`.
+    pub fn name(self) -> &'static str {
+        match self {
+            TargetFormat::LinearF32 => "f32",
+            TargetFormat::Srgb8 => "srgb8",
+        }
+    }
+}
+
+impl std::fmt::Display for TargetFormat {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for TargetFormat {
+    type Err = String;
+
+    fn from_str(s: &str) -> Result<Self, String> {
+        TargetFormat::ALL
+            .into_iter()
+            .find(|t| t.name() == s)
+            .ok_or_else(|| format!("unknown target format '{s}' (expected f32 or srgb8)"))
+    }
+}
 
 use crate::error::RenderError;
 use crate::fixed::{TILE_LOG2, TILE_PIXELS, TILE_SIZE};
 use crate::multisample::{SampleCount, MAX_MULTISAMPLE_TARGET_BYTES};
 use crate::raster::bin::TileGrid;
 
-/// Bytes the tiles of a `width × height` target take: 16 bytes of linear RGBA and 4 of depth
-/// per pixel, for every pixel of the whole 64 × 64 tiles covering it (saturating).
+/// Bytes the tiles of a `width × height` `f32` target take: 16 bytes of linear RGBA and 4 of
+/// depth per pixel, for every pixel of the whole 64 × 64 tiles covering it (saturating).
 pub fn framebuffer_bytes(width: u32, height: u32) -> usize {
     multisample_framebuffer_bytes(width, height, SampleCount::X1)
+}
+
+/// Bytes the tiles of a `width × height` target in `format` with `samples` samples per pixel
+/// take (saturating): [`multisample_framebuffer_bytes`] for `f32`; for 8-bit sRGB 4 bytes of
+/// colour per sample and 4 of depth per depth plane, plus one `f32` tile per worker thread
+/// (`workers`).
+pub fn target_bytes(
+    width: u32,
+    height: u32,
+    samples: SampleCount,
+    format: TargetFormat,
+    workers: usize,
+) -> usize {
+    match format {
+        TargetFormat::LinearF32 => multisample_framebuffer_bytes(width, height, samples),
+        TargetFormat::Srgb8 => TileGrid::new(width, height)
+            .tile_count()
+            .saturating_mul(Srgb8Tile::bytes(samples))
+            .saturating_add(
+                workers
+                    .saturating_mul(multisample_framebuffer_bytes(TILE_SIZE, TILE_SIZE, samples)),
+            ),
+    }
 }
 
 /// Depth planes of a tile with `samples` samples per pixel.
@@ -54,33 +129,98 @@ pub fn readback_bytes(width: u32, height: u32, bytes_per_pixel: usize) -> usize 
 
 /// A colour + depth target stored as tiles. It may hold only a band of the target's rows
 /// ([`Framebuffer::rows`]): the viewport is the whole target's, readback returns the band.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub struct Framebuffer {
     grid: TileGrid,
-    tiles: Vec<TileBuffer>,
+    storage: Storage,
     /// The pixel rows held and read back (`0..height` for a whole target).
     rows: std::ops::Range<u32>,
     samples: SampleCount,
 }
 
+/// The tiles of a target, by [`TargetFormat`].
+#[derive(Debug)]
+enum Storage {
+    LinearF32(Vec<TileBuffer>),
+    Srgb8 {
+        tiles: Vec<Srgb8Tile>,
+        /// One `f32` tile per worker thread (rayon's thread index, modulo their number), where
+        /// the tiles with work are drawn ([`srgb8`]).
+        workers: Vec<Mutex<TileBuffer>>,
+    },
+}
+
+/// A tile of either format, for readback.
+#[derive(Clone, Copy)]
+enum TileRef<'a> {
+    LinearF32(&'a TileBuffer),
+    Srgb8(&'a Srgb8Tile),
+}
+
+impl TileRef<'_> {
+    #[inline]
+    fn color_at(self, index: usize) -> Vec4 {
+        match self {
+            TileRef::LinearF32(t) => t.color_at(index),
+            TileRef::Srgb8(t) => t.color_at(index),
+        }
+    }
+
+    #[inline]
+    fn depth_at(self, index: usize) -> f32 {
+        match self {
+            TileRef::LinearF32(t) => t.depth_at(index),
+            TileRef::Srgb8(t) => t.depth_at(index),
+        }
+    }
+}
+
+/// `n` values made by `make`, or an error instead of an abort when memory runs out.
+fn try_vec<T>(
+    n: usize,
+    mut make: impl FnMut() -> Result<T, RenderError>,
+) -> Result<Vec<T>, RenderError> {
+    let mut v = Vec::new();
+    v.try_reserve_exact(n)
+        .map_err(|_| RenderError::OutOfMemory {
+            what: "render target",
+            bytes: n.saturating_mul(std::mem::size_of::<T>()),
+        })?;
+    for _ in 0..n {
+        v.push(make()?);
+    }
+    Ok(v)
+}
+
 impl Framebuffer {
-    /// A target of `width × height` with `samples` samples per pixel (sides checked by the
-    /// caller), cleared to transparent black and depth 1.
+    /// An `f32` target of `width × height` with `samples` samples per pixel (sides checked by
+    /// the caller), cleared to transparent black and depth 1.
     pub(crate) fn new(width: u32, height: u32, samples: SampleCount) -> Result<Self, RenderError> {
-        Self::band(width, height, 0..height, samples)
+        Self::band(
+            width,
+            height,
+            0..height,
+            samples,
+            TargetFormat::LinearF32,
+            1,
+        )
     }
 
     /// Rows `rows` (non-empty, within `0..height`, checked by the caller) of a `width × height`
-    /// target with `samples` samples per pixel: only the tiles holding them are allocated. A
-    /// multisampled band larger than [`MAX_MULTISAMPLE_TARGET_BYTES`] is refused before anything
-    /// is allocated.
+    /// target in `format` with `samples` samples per pixel: only the tiles holding them are
+    /// allocated (and, for 8-bit sRGB, one `f32` tile for each of `workers` threads). A
+    /// multisampled band larger than [`MAX_MULTISAMPLE_TARGET_BYTES`] is refused before
+    /// anything is allocated.
     pub(crate) fn band(
         width: u32,
         height: u32,
         rows: std::ops::Range<u32>,
         samples: SampleCount,
+        format: TargetFormat,
+        workers: usize,
     ) -> Result<Self, RenderError> {
-        let bytes = multisample_framebuffer_bytes(width, rows.end - rows.start, samples);
+        let workers = workers.max(1);
+        let bytes = target_bytes(width, rows.end - rows.start, samples, format, workers);
         if samples.is_multisampled() && bytes > MAX_MULTISAMPLE_TARGET_BYTES {
             return Err(RenderError::Unsupported {
                 backend: "cpu".into(),
@@ -98,22 +238,29 @@ impl Framebuffer {
             height,
             rows.start >> TILE_LOG2..rows.end.div_ceil(TILE_SIZE),
         );
-        let mut tiles = Vec::new();
-        tiles
-            .try_reserve_exact(grid.tile_count())
-            .map_err(|_| RenderError::OutOfMemory {
-                what: "render target",
-                bytes: grid.tile_count() * std::mem::size_of::<TileBuffer>(),
-            })?;
-        for _ in 0..grid.tile_count() {
-            tiles.push(TileBuffer::new(samples)?);
-        }
+        let storage = match format {
+            TargetFormat::LinearF32 => {
+                Storage::LinearF32(try_vec(grid.tile_count(), || TileBuffer::new(samples))?)
+            }
+            TargetFormat::Srgb8 => Storage::Srgb8 {
+                tiles: try_vec(grid.tile_count(), || Srgb8Tile::new(samples))?,
+                workers: try_vec(workers, || TileBuffer::new(samples).map(Mutex::new))?,
+            },
+        };
         Ok(Self {
             grid,
-            tiles,
+            storage,
             rows,
             samples,
         })
+    }
+
+    /// How the target stores colour.
+    pub fn format(&self) -> TargetFormat {
+        match self.storage {
+            Storage::LinearF32(_) => TargetFormat::LinearF32,
+            Storage::Srgb8 { .. } => TargetFormat::Srgb8,
+        }
     }
 
     /// Samples per pixel.
@@ -141,16 +288,99 @@ impl Framebuffer {
         &self.grid
     }
 
-    pub(crate) fn tiles_mut(&mut self) -> &mut [TileBuffer] {
-        &mut self.tiles
+    /// The `f32` tiles of an `f32` target (`None` for other formats).
+    #[cfg(test)]
+    pub(crate) fn f32_tiles_mut(&mut self) -> Option<&mut [TileBuffer]> {
+        match &mut self.storage {
+            Storage::LinearF32(tiles) => Some(tiles),
+            Storage::Srgb8 { .. } => None,
+        }
     }
 
-    /// Sets every pixel's colour and/or depth.
+    /// Runs `work(state, tile_index, tile)` on every tile for which `busy(tile_index)` holds,
+    /// tiles in parallel in pieces of at most `piece` tiles (`init` makes one `state` per
+    /// piece), and sums the results with `sum` (tiles not visited give `R::default()`). The
+    /// tile is an `f32` one whatever the format: an 8-bit target's tile is decoded into the
+    /// worker's `f32` tile, worked on there and encoded back with the lanes of `isa`
+    /// ([`srgb8`]).
+    pub(crate) fn par_tiles<S, R: Default + Send>(
+        &mut self,
+        piece: usize,
+        isa: Isa,
+        busy: impl Fn(usize) -> bool + Sync + Send,
+        init: impl Fn() -> S + Sync + Send,
+        work: impl Fn(&mut S, usize, &mut TileBuffer) -> R + Sync + Send,
+        sum: impl Fn(R, R) -> R + Sync + Send,
+    ) -> R {
+        match &mut self.storage {
+            Storage::LinearF32(tiles) => tiles
+                .par_iter_mut()
+                .enumerate()
+                .with_max_len(piece)
+                .map_init(init, |state, (i, tile)| match busy(i) {
+                    true => work(state, i, tile),
+                    false => R::default(),
+                })
+                .reduce(R::default, sum),
+            Storage::Srgb8 { tiles, workers } => {
+                let workers = &*workers;
+                tiles
+                    .par_iter_mut()
+                    .enumerate()
+                    .with_max_len(piece)
+                    .map_init(init, |state, (i, tile)| {
+                        if !busy(i) {
+                            return R::default();
+                        }
+                        let worker = rayon::current_thread_index().unwrap_or(0) % workers.len();
+                        // Each worker thread locks its own tile; the work does not fork, so a
+                        // thread never waits on itself. A poisoned lock (a panic while drawing)
+                        // is taken over: `load` replaces everything the tile holds.
+                        let mut scratch = workers[worker]
+                            .lock()
+                            .unwrap_or_else(|poisoned| poisoned.into_inner());
+                        srgb8::load(&mut scratch, tile);
+                        let result = work(state, i, &mut scratch);
+                        srgb8::store(tile, &scratch, isa);
+                        result
+                    })
+                    .reduce(R::default, sum)
+            }
+        }
+    }
+
+    /// Sets every pixel's colour and/or depth. Clearing both only records the clear; clearing
+    /// one of them writes it (on an 8-bit target through the workers' `f32` tiles).
     pub fn clear(&mut self, color: Option<Vec4>, depth: Option<f32>) {
-        use rayon::prelude::*;
-        self.tiles
-            .par_iter_mut()
-            .for_each(|tile| tile.fill(color, depth));
+        match &mut self.storage {
+            Storage::LinearF32(tiles) => {
+                tiles.par_iter_mut().for_each(|t| t.fill(color, depth));
+                return;
+            }
+            Storage::Srgb8 { tiles, .. } => {
+                if let (Some(color), Some(depth)) = (color, depth) {
+                    tiles.par_iter_mut().for_each(|t| t.clear(color, depth));
+                    return;
+                }
+            }
+        }
+        self.par_tiles(
+            1,
+            Isa::selected(),
+            |_| true,
+            || (),
+            |_, _, tile| tile.fill(color, depth),
+            |(), ()| (),
+        )
+    }
+
+    /// The tile at `index`.
+    #[inline]
+    fn tile(&self, index: usize) -> TileRef<'_> {
+        match &self.storage {
+            Storage::LinearF32(tiles) => TileRef::LinearF32(&tiles[index]),
+            Storage::Srgb8 { tiles, .. } => TileRef::Srgb8(&tiles[index]),
+        }
     }
 
     // Readback (robust branch). Everything goes through `read_rows`, which holds one row of
@@ -162,7 +392,7 @@ impl Framebuffer {
     fn read_rows<T: Copy + Default>(
         &self,
         per_pixel: usize,
-        get: impl Fn(&TileBuffer, usize, &mut [T]),
+        get: impl Fn(TileRef<'_>, usize, &mut [T]),
         mut emit: impl FnMut(u32, &[T]),
     ) {
         let w = self.grid.width as usize;
@@ -171,7 +401,7 @@ impl Framebuffer {
             let band_row = (y >> TILE_LOG2) - self.grid.first_row;
             let tile_row = band_row as usize * self.grid.tiles_x as usize;
             for (x, out) in row.chunks_exact_mut(per_pixel).enumerate() {
-                let tile = &self.tiles[tile_row + (x >> TILE_LOG2)];
+                let tile = self.tile(tile_row + (x >> TILE_LOG2));
                 get(tile, TileBuffer::index(x as i32, y as i32), out);
             }
             emit(y, &row);
@@ -271,13 +501,13 @@ impl Framebuffer {
     }
 
     /// The tile and the index within it of pixel `(x, y)`, if it lies on the target.
-    fn locate(&self, x: u32, y: u32) -> Option<(&TileBuffer, usize)> {
+    fn locate(&self, x: u32, y: u32) -> Option<(TileRef<'_>, usize)> {
         if x >= self.grid.width || !self.rows.contains(&y) {
             return None;
         }
         let band_row = (y >> TILE_LOG2) - self.grid.first_row;
         let tile = band_row as usize * self.grid.tiles_x as usize + (x >> TILE_LOG2) as usize;
-        Some((&self.tiles[tile], TileBuffer::index(x as i32, y as i32)))
+        Some((self.tile(tile), TileBuffer::index(x as i32, y as i32)))
     }
 
     /// Colour of one pixel (`None` outside the target).
@@ -357,7 +587,7 @@ mod tests {
             let color = Vec4::new(0.1, 0.7, 1.0 / 3.0, 0.9);
             fb.clear(Some(color), Some(0.375));
             let deferred = (fb.read_color(), fb.read_depth());
-            for tile in fb.tiles_mut() {
+            for tile in fb.f32_tiles_mut().expect("f32 target") {
                 tile.materialize();
             }
             let written = (fb.read_color(), fb.read_depth());
@@ -378,7 +608,7 @@ mod tests {
         // Tile 0's block 9 (pixels x 8..16, y 8..16) and tile 1's block 0 (x 64..72, y 0..8).
         let taken = [(0, 9, 8, 8), (1, 0, 64, 0)];
         for (tile, block, x, y) in taken {
-            let tile = &mut fb.tiles_mut()[tile];
+            let tile = &mut fb.f32_tiles_mut().expect("f32 target")[tile];
             let clear = tile
                 .take_pending_block(block)
                 .expect("pending after a clear");
@@ -415,7 +645,7 @@ mod tests {
                 .collect()
         };
         assert_eq!(read(&fb), expected, "deferred");
-        for tile in fb.tiles_mut() {
+        for tile in fb.f32_tiles_mut().expect("f32 target") {
             tile.materialize();
             assert!(tile.take_pending_block(3).is_none());
         }

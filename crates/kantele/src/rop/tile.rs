@@ -23,18 +23,27 @@ const BLOCKS_PER_TILE: usize = ((TILE_SIZE >> BLOCK_LOG2) * (TILE_SIZE >> BLOCK_
 #[derive(Clone, Debug)]
 pub struct TileBuffer {
     /// Linear colour planes: red at `0..TILE_PIXELS·N`, then green, blue and alpha.
-    color: Vec<f32>,
+    pub(super) color: Vec<f32>,
     /// Window depth planes: the pixel centre's, then each sample's (multisampled only).
-    depth: Vec<f32>,
+    pub(super) depth: Vec<f32>,
     /// Samples per pixel (1, 4 or 8).
-    samples: usize,
+    pub(super) samples: usize,
+    /// The depth hierarchy and the deferred clear: what an 8-bit target's tile keeps beside
+    /// its storage ([`super::srgb8`]).
+    pub(super) state: TileState,
+}
+
+/// A tile's bookkeeping beside its colour and depth storage: the depth hierarchy's bounds and
+/// the deferred clear.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct TileState {
     /// An upper bound of every value in `depth` (kept by every depth write).
-    depth_bound: f32,
+    pub(super) depth_bound: f32,
     /// Whether `depth_bound` is the exact maximum (false after writes until recomputed).
-    depth_bound_exact: bool,
+    pub(super) depth_bound_exact: bool,
     /// The largest depth of each 8 × 8 block (row-major blocks of the tile), kept exact by the
     /// per-pixel path after every block it writes: the second level of the depth hierarchy.
-    block_depth_max: [f32; BLOCKS_PER_TILE],
+    pub(super) block_depth_max: [f32; BLOCKS_PER_TILE],
     /// A clear not yet written to (some blocks of) the storage: while set, every pixel and
     /// sample of a block in its `pending` set holds this colour and depth, whatever `color` and
     /// `depth` contain. Clearing a frame only records it. At 1× the per-pixel path writes a
@@ -42,7 +51,7 @@ pub struct TileBuffer {
     /// ([`TileBuffer::take_pending_block`]: every pixel of the block is stored once, the
     /// triangle's where it wrote, the clear elsewhere); other paths write all pending blocks
     /// first ([`TileBuffer::materialize`]). A block that no triangle reaches is never written.
-    deferred_clear: Option<DeferredClear>,
+    pub(super) deferred_clear: Option<DeferredClear>,
 }
 
 /// The values of a clear that some blocks of a tile have not written to the storage yet.
@@ -63,7 +72,7 @@ const _: () = assert!(
 );
 
 /// Every block of a tile pending.
-const ALL_BLOCKS: u64 = u64::MAX;
+pub(super) const ALL_BLOCKS: u64 = u64::MAX;
 
 /// Pixels from the first of an 8 × 8 block to its last, in a tile's row-major order: seven
 /// tile rows and one block row.
@@ -109,10 +118,7 @@ impl TileBuffer {
             color: filled_vec(4 * n * TILE_PIXELS, 0.0)?,
             depth: filled_vec(depth_planes(samples) * TILE_PIXELS, 1.0)?,
             samples: n,
-            depth_bound: 1.0,
-            depth_bound_exact: true,
-            block_depth_max: [1.0; BLOCKS_PER_TILE],
-            deferred_clear: None,
+            state: TileState::new(),
         })
     }
 
@@ -247,35 +253,21 @@ impl TileBuffer {
     pub fn color_at(&self, index: usize) -> Vec4 {
         // A deferred clear resolves through the same sum and division as stored samples, so it
         // reads back bit for bit as a written one.
-        match self.deferred_clear {
-            Some(clear) if clear.holds(index) => self.resolve(|c, _| clear.color[c]),
+        match self.state.deferred_clear {
+            Some(clear) if clear.holds(index) => resolve(self.samples, |c, _| clear.color[c]),
             _ => {
                 let plane = self.samples * TILE_PIXELS;
-                self.resolve(|c, s| self.color[c * plane + s * TILE_PIXELS + index])
+                resolve(self.samples, |c, s| {
+                    self.color[c * plane + s * TILE_PIXELS + index]
+                })
             }
         }
-    }
-
-    /// A pixel's colour from `sample(channel, sample)`: the value itself at 1×, the mean of the
-    /// samples (summed in sample order) when multisampled.
-    #[inline]
-    fn resolve(&self, sample: impl Fn(usize, usize) -> f32) -> Vec4 {
-        if self.samples == 1 {
-            return Vec4::from_array(std::array::from_fn(|c| sample(c, 0)));
-        }
-        let mut sum = [0.0f32; 4];
-        for (c, total) in sum.iter_mut().enumerate() {
-            for s in 0..self.samples {
-                *total += sample(c, s);
-            }
-        }
-        Vec4::from_array(sum) / self.samples as f32
     }
 
     /// The depth of the pixel at tile index `index`.
     #[inline]
     pub fn depth_at(&self, index: usize) -> f32 {
-        match self.deferred_clear {
+        match self.state.deferred_clear {
             Some(clear) if clear.holds(index) => clear.depth,
             _ => self.depth[index],
         }
@@ -286,7 +278,7 @@ impl TileBuffer {
     /// ([`TileBuffer::take_pending_block`]) call it first.
     #[inline]
     pub(crate) fn materialize(&mut self) {
-        let Some(clear) = self.deferred_clear.take() else {
+        let Some(clear) = self.state.deferred_clear.take() else {
             return;
         };
         if clear.pending == ALL_BLOCKS {
@@ -315,14 +307,14 @@ impl TileBuffer {
     #[inline(always)]
     pub fn take_pending_block(&mut self, block: usize) -> Option<DeferredClear> {
         debug_assert_eq!(self.samples, 1);
-        let clear = self.deferred_clear.as_mut()?;
+        let clear = self.state.deferred_clear.as_mut()?;
         if !clear.pending_block(block) {
             return None;
         }
         let taken = *clear;
         clear.pending &= !(1u64 << block);
         if clear.pending == 0 {
-            self.deferred_clear = None;
+            self.state.deferred_clear = None;
         }
         Some(taken)
     }
@@ -339,7 +331,7 @@ impl TileBuffer {
     #[inline(always)]
     fn debug_assert_materialized(&self) {
         debug_assert!(
-            self.deferred_clear.is_none(),
+            self.state.deferred_clear.is_none(),
             "tile storage used before materialize"
         );
     }
@@ -348,7 +340,9 @@ impl TileBuffer {
     #[inline(always)]
     fn debug_assert_block_written(&self, first: usize) {
         debug_assert!(
-            self.deferred_clear.is_none_or(|clear| !clear.holds(first)),
+            self.state
+                .deferred_clear
+                .is_none_or(|clear| !clear.holds(first)),
             "block storage used before its pending clear was taken"
         );
     }
@@ -365,49 +359,38 @@ impl TileBuffer {
     /// test on every pixel of block `block` (so the block can be skipped).
     #[inline(always)]
     pub fn block_occludes(&self, block: usize, min_depth: f32) -> bool {
-        min_depth - DEPTH_BOUND_SLACK > self.block_depth_max[block]
+        min_depth - DEPTH_BOUND_SLACK > self.state.block_depth_max[block]
     }
 
     /// Records the exact largest depth of block `block` after the per-pixel path wrote it, and
     /// keeps the tile's bound valid.
     #[inline(always)]
     pub fn set_block_depth_max(&mut self, block: usize, max_depth: f32) {
-        self.block_depth_max[block] = max_depth;
+        self.state.block_depth_max[block] = max_depth;
         self.note_depth_written(max_depth);
     }
 
     /// Records that depths up to `max_depth` were written, keeping the tile's bound valid.
     #[inline]
     pub fn note_depth_written(&mut self, max_depth: f32) {
-        self.depth_bound = self.depth_bound.max(max_depth);
-        self.depth_bound_exact = false;
+        self.state.depth_bound = self.state.depth_bound.max(max_depth);
+        self.state.depth_bound_exact = false;
     }
 
     /// Fills colour and/or depth. Clearing both is deferred ([`TileBuffer::materialize`]);
     /// clearing one of them writes a pending clear first, then that one.
     pub(super) fn fill(&mut self, color: Option<Vec4>, depth: Option<f32>) {
-        match (color, depth) {
-            (Some(color), Some(depth)) => {
-                self.deferred_clear = Some(DeferredClear {
-                    color,
-                    depth,
-                    pending: ALL_BLOCKS,
-                })
-            }
-            _ => {
-                self.materialize();
-                if let Some(c) = color {
-                    self.write_color(c);
-                }
-                if let Some(d) = depth {
-                    self.depth.fill(d);
-                }
-            }
+        if let (Some(color), Some(depth)) = (color, depth) {
+            self.state.clear(color, depth);
+            return;
+        }
+        self.materialize();
+        if let Some(c) = color {
+            self.write_color(c);
         }
         if let Some(d) = depth {
-            self.depth_bound = d;
-            self.depth_bound_exact = true;
-            self.block_depth_max = [d; BLOCKS_PER_TILE];
+            self.depth.fill(d);
+            self.state.reset_depth(d);
         }
     }
 
@@ -419,16 +402,16 @@ impl TileBuffer {
     #[inline]
     pub fn occludes(&mut self, min_depth: f32, area: i32, tile: &PixelRect) -> bool {
         let min_depth = min_depth - DEPTH_BOUND_SLACK;
-        if min_depth > self.depth_bound {
+        if min_depth > self.state.depth_bound {
             return true;
         }
         let tile_area = tile.width() * tile.height();
-        if self.depth_bound_exact || area < DEPTH_BOUND_REFRESH_AREA.min(tile_area / 4) {
+        if self.state.depth_bound_exact || area < DEPTH_BOUND_REFRESH_AREA.min(tile_area / 4) {
             return false;
         }
-        self.depth_bound = self.exact_depth_bound(tile);
-        self.depth_bound_exact = true;
-        min_depth > self.depth_bound
+        self.state.depth_bound = self.exact_depth_bound(tile);
+        self.state.depth_bound_exact = true;
+        min_depth > self.state.depth_bound
     }
 
     /// The largest depth of the tile's pixels on the target (`tile` is the tile's rectangle on
@@ -437,7 +420,7 @@ impl TileBuffer {
     /// gives its exact maximum, kept by the per-pixel paths, so only blocks cut by the
     /// target's edge are read pixel by pixel: 64 values instead of 4096 for an inner tile.
     fn exact_depth_bound(&self, tile: &PixelRect) -> f32 {
-        let pending = match self.deferred_clear {
+        let pending = match self.state.deferred_clear {
             Some(clear) if clear.pending == ALL_BLOCKS => return clear.depth,
             Some(clear) => Some(clear),
             None => None,
@@ -448,7 +431,7 @@ impl TileBuffer {
             // the largest of the 64 kept block maxima (a pending block's is its clear depth),
             // taken eight at a time so that the compiler keeps it in vector registers.
             let mut lanes = [f32::NEG_INFINITY; 8];
-            for eight in self.block_depth_max.chunks_exact(8) {
+            for eight in self.state.block_depth_max.chunks_exact(8) {
                 for (lane, &value) in lanes.iter_mut().zip(eight) {
                     *lane = lane.max(value);
                 }
@@ -471,7 +454,7 @@ impl TileBuffer {
                 }
                 let block_index = Self::block_index(x0, y0);
                 if y1 - y0 == block && x1 - x0 == block {
-                    bound = bound.max(self.block_depth_max[block_index]);
+                    bound = bound.max(self.state.block_depth_max[block_index]);
                     continue;
                 }
                 if let Some(clear) = pending.filter(|c| c.pending_block(block_index)) {
@@ -501,19 +484,70 @@ impl TileBuffer {
     }
 }
 
+impl TileState {
+    /// The state of a new tile: depth 1 everywhere, nothing deferred.
+    fn new() -> Self {
+        Self {
+            depth_bound: 1.0,
+            depth_bound_exact: true,
+            block_depth_max: [1.0; BLOCKS_PER_TILE],
+            deferred_clear: None,
+        }
+    }
+
+    /// Records a clear of colour and depth for every block, deferred.
+    pub(super) fn clear(&mut self, color: Vec4, depth: f32) {
+        self.deferred_clear = Some(DeferredClear {
+            color,
+            depth,
+            pending: ALL_BLOCKS,
+        });
+        self.reset_depth(depth);
+    }
+
+    /// The depth bounds after every depth was set to `depth`.
+    fn reset_depth(&mut self, depth: f32) {
+        self.depth_bound = depth;
+        self.depth_bound_exact = true;
+        self.block_depth_max = [depth; BLOCKS_PER_TILE];
+    }
+
+    /// The blocks whose storage does not hold their values yet (bit `b` for block `b`; 0
+    /// when nothing is deferred).
+    pub(super) fn pending_blocks(&self) -> u64 {
+        self.deferred_clear.map_or(0, |clear| clear.pending)
+    }
+}
+
 impl DeferredClear {
     /// Whether block `block` is pending.
     #[inline(always)]
-    fn pending_block(&self, block: usize) -> bool {
+    pub(super) fn pending_block(&self, block: usize) -> bool {
         self.pending & (1u64 << block) != 0
     }
 
     /// Whether the pixel at tile index `index` lies in a pending block.
     #[inline(always)]
-    fn holds(&self, index: usize) -> bool {
+    pub(super) fn holds(&self, index: usize) -> bool {
         let (x, y) = (index % TILE_SIZE as usize, index / TILE_SIZE as usize);
         self.pending_block(TileBuffer::block_index(x as i32, y as i32))
     }
+}
+
+/// A pixel's colour from `sample(channel, sample)` of its `samples` samples: the value itself
+/// at 1×, the mean of the samples (summed in sample order) when multisampled.
+#[inline]
+pub(super) fn resolve(samples: usize, sample: impl Fn(usize, usize) -> f32) -> Vec4 {
+    if samples == 1 {
+        return Vec4::from_array(std::array::from_fn(|c| sample(c, 0)));
+    }
+    let mut sum = [0.0f32; 4];
+    for (c, total) in sum.iter_mut().enumerate() {
+        for s in 0..samples {
+            *total += sample(c, s);
+        }
+    }
+    Vec4::from_array(sum) / samples as f32
 }
 
 /// Sets the 8 × 8 block of `plane` (one tile plane) whose first pixel is `first` to `value`.
@@ -526,7 +560,7 @@ fn fill_block(plane: &mut [f32], first: usize, value: f32) {
 
 /// Tile index of the first pixel of block `block` (the inverse of [`TileBuffer::block_index`]).
 #[inline(always)]
-fn block_first_pixel(block: usize) -> usize {
+pub(super) fn block_first_pixel(block: usize) -> usize {
     let blocks_per_row = (TILE_SIZE / BLOCK_SIZE) as usize;
     let (bx, by) = (block % blocks_per_row, block / blocks_per_row);
     TileBuffer::index(
@@ -536,7 +570,7 @@ fn block_first_pixel(block: usize) -> usize {
 }
 
 /// A vector of `n` copies of `value`, or an error instead of an abort when memory runs out.
-fn filled_vec<T: Clone>(n: usize, value: T) -> Result<Vec<T>, RenderError> {
+pub(super) fn filled_vec<T: Clone>(n: usize, value: T) -> Result<Vec<T>, RenderError> {
     let mut v = Vec::new();
     v.try_reserve_exact(n)
         .map_err(|_| RenderError::OutOfMemory {

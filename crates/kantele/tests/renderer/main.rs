@@ -15,3 +15,4 @@ mod pipeline;
 mod points_lines;
 mod reference;
 mod robustness;
+mod target_format;
