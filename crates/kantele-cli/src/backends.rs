@@ -24,6 +24,7 @@ fn make_plain_backend(kind: BackendKind, cpu: &CpuArgs, fast: bool) -> Result<Bo
                 threads: cpu.threads,
                 strategy: cpu.strategy.unwrap_or_default(),
                 timeout: cpu.timeout,
+                target: cpu.target,
                 ..CpuOptions::default()
             };
             let backend = CpuBackend::new(options).map_err(|e| anyhow!("cpu backend: {e}"))?;

@@ -98,6 +98,8 @@ struct Row {
     renderer: String,
     threads: usize,
     isa: String,
+    /// How colour frames are stored (`f32`, `srgb8`, `rgba8`).
+    target: String,
     /// Samples per pixel of the colour frames.
     msaa: usize,
     result: Result<FrameTimes, String>,
@@ -135,7 +137,7 @@ fn time_frames(
 
 fn print_table(rows: &[Row], ratios: bool) {
     let mut header = format!(
-        "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:<6} {:>4} {:>10} {:>10} {:>10}",
+        "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:<6} {:<6} {:>4} {:>10} {:>10} {:>10}",
         "scene",
         "size",
         "triangles",
@@ -144,6 +146,7 @@ fn print_table(rows: &[Row], ratios: bool) {
         "renderer",
         "threads",
         "isa",
+        "target",
         "msaa",
         "median ms",
         "min ms",
@@ -156,8 +159,17 @@ fn print_table(rows: &[Row], ratios: bool) {
     for r in rows {
         let size = format!("{}x{}", r.width, r.height);
         let mut line = format!(
-            "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:<6} {:>4}",
-            r.scene, size, r.triangles, r.draws, r.backend, r.renderer, r.threads, r.isa, r.msaa
+            "{:<24} {:>11} {:>10} {:>6}  {:<7} {:<36} {:>7} {:<6} {:<6} {:>4}",
+            r.scene,
+            size,
+            r.triangles,
+            r.draws,
+            r.backend,
+            r.renderer,
+            r.threads,
+            r.isa,
+            r.target,
+            r.msaa
         );
         match &r.result {
             Ok(FrameTimes { frames: t, .. }) => {
@@ -185,8 +197,8 @@ fn print_side_by_side(rows: &[Row], backends: &[String]) {
     for name in backends {
         if let Some(r) = rows.iter().find(|r| &r.backend == name && r.result.is_ok()) {
             println!(
-                "{name}: {} ({} threads, isa {}, msaa {})",
-                r.renderer, r.threads, r.isa, r.msaa
+                "{name}: {} ({} threads, isa {}, target {}, msaa {})",
+                r.renderer, r.threads, r.isa, r.target, r.msaa
             );
         }
     }
@@ -279,6 +291,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         let mut any_ok = false;
         for (i, (name, backend)) in backends.iter_mut().enumerate() {
             let msaa = backend.as_ref().map_or(0, |b| b.samples().count());
+            let target = backend.as_ref().map_or("-".to_string(), |b| b.target());
             let (renderer, threads, isa, result) = match backend {
                 Ok(b) => {
                     let result = b
@@ -314,6 +327,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 renderer,
                 threads,
                 isa,
+                target,
                 msaa,
                 result,
                 ratio,
@@ -331,7 +345,7 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                         "scene": row.scene, "source": loaded.info.source,
                         "width": row.width, "height": row.height,
                         "triangles": row.triangles, "draws": row.draws,
-                        "backend": row.backend, "renderer": row.renderer, "threads": row.threads, "isa": row.isa, "msaa": row.msaa,
+                        "backend": row.backend, "renderer": row.renderer, "threads": row.threads, "isa": row.isa, "target": row.target, "msaa": row.msaa,
                         "frames": args.frames, "warmup": args.warmup,
                         "median_ms": median, "min_ms": min, "max_ms": max,
                         "geometry_ms": stages.map(|s| s.geometry),

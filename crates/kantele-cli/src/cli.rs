@@ -5,6 +5,7 @@ use std::path::PathBuf;
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use kantele::multisample::SampleCount;
 use kantele::raster::Strategy;
+use kantele::rop::TargetFormat;
 
 /// Kantele: a software rasterizer. Render, inspect, benchmark, compare and view glTF 2.0 / OBJ
 /// scenes by the rules of the reference scenes (`shared/scenes/README.md`).
@@ -175,6 +176,15 @@ pub struct CpuArgs {
     /// normals stay per pixel). Every backend draws it; llvmpipe's OpenGL offers at most 4.
     #[arg(long, value_name = "N", default_value_t = SampleCount::X1, value_parser = parse_msaa)]
     pub msaa: SampleCount,
+    /// CPU colour target: f32 (linear floats, exact) or srgb8 (8-bit sRGB, a quarter of the
+    /// colour memory; the same 8-bit pictures). Normals and ids always use f32.
+    #[arg(long, value_name = "FORMAT", default_value_t = TargetFormat::LinearF32, value_parser = parse_target)]
+    pub target: TargetFormat,
+}
+
+/// Parses `--target`: f32 or srgb8.
+fn parse_target(s: &str) -> Result<TargetFormat, String> {
+    s.parse()
 }
 
 /// Parses `--msaa`: 1, 4 or 8.

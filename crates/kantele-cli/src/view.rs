@@ -123,6 +123,7 @@ impl App {
             threads: self.args.cpu.threads,
             strategy,
             samples: self.args.cpu.msaa,
+            target: self.args.cpu.target,
             ..CpuOptions::default()
         })
         .map_err(|e| anyhow!("cpu backend: {e}"))?;

@@ -281,6 +281,15 @@ impl Backend for GlBackend {
         self.renderer.clone()
     }
 
+    /// `GL_RGBA8` (`"rgba8"`) with [`GlBackend::set_fast_target`], else `GL_RGBA32F` (`"f32"`).
+    fn target(&self) -> String {
+        match self.fast_target {
+            true => "rgba8",
+            false => "f32",
+        }
+        .to_string()
+    }
+
     /// For llvmpipe, its rasterizer threads (`LP_NUM_THREADS`, else the number of cores, as
     /// Mesa chooses them); 1 for a GPU driver.
     fn threads(&self) -> usize {
