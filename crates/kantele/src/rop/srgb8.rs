@@ -38,6 +38,9 @@ pub struct Srgb8Tile {
     samples: usize,
     /// Depth bounds and the deferred clear, as [`TileBuffer`]'s.
     state: TileState,
+    /// The deferred clear's colour and its packed 8-bit value (encoded once, not per pixel read
+    /// back).
+    clear_texel: (Vec4, u32),
 }
 
 impl Srgb8Tile {
@@ -50,6 +53,7 @@ impl Srgb8Tile {
             depth: f32_tile.depth,
             samples: samples.count(),
             state: f32_tile.state,
+            clear_texel: (Vec4::ZERO, 0),
         })
     }
 
@@ -62,15 +66,28 @@ impl Srgb8Tile {
     /// Records a clear of colour and depth (nothing is written).
     pub(super) fn clear(&mut self, color: Vec4, depth: f32) {
         self.state.clear(color, depth);
+        self.note_clear_color();
+    }
+
+    /// Keeps `clear_texel` the packed value of the deferred clear's colour.
+    fn note_clear_color(&mut self) {
+        if let Some(clear) = self.state.deferred_clear {
+            if clear.color.to_array().map(f32::to_bits)
+                != self.clear_texel.0.to_array().map(f32::to_bits)
+            {
+                self.clear_texel = (
+                    clear.color,
+                    pack_rgba8(encode_rgba8(clear.color.to_array(), true)),
+                );
+            }
+        }
     }
 
     /// The packed value of sample `sample` of the pixel at tile index `index`.
     #[inline]
     fn texel(&self, sample: usize, index: usize) -> u32 {
         match self.state.deferred_clear {
-            Some(clear) if clear.holds(index) => {
-                pack_rgba8(encode_rgba8(clear.color.to_array(), true))
-            }
+            Some(clear) if clear.holds(index) => self.clear_texel.1,
             _ => self.color[sample * TILE_PIXELS + index] as u32,
         }
     }
@@ -124,6 +141,7 @@ pub(super) fn load(scratch: &mut TileBuffer, tile: &Srgb8Tile) {
 pub(super) fn store(tile: &mut Srgb8Tile, scratch: &TileBuffer, isa: Isa) {
     debug_assert_eq!(scratch.samples, tile.samples);
     tile.state = scratch.state;
+    tile.note_clear_color();
     let pending = tile.state.pending_blocks();
     if pending == ALL_BLOCKS {
         return;
