@@ -160,9 +160,11 @@ class Scene:
         backend: Backend = "cpu",
         threads: Optional[int] = None,
         msaa: int = 1,
+        target: Literal["f32", "srgb8"] = "f32",
     ) -> Dict[str, np.ndarray]:
         """Renders one view (GIL released); `msaa` = samples per pixel of colour (1, 4 or 8;
-        depth, normals and ids stay per pixel). Outputs (default color, depth, normals, ids):
+        depth, normals and ids stay per pixel); `target` = the CPU colour target ("srgb8":
+        8-bit sRGB tiles, the same uint8 color). Outputs (default color, depth, normals, ids):
         color uint8 (H, W, 4) sRGB; color_linear float32 (H, W, 4); depth float32 (H, W)
         distance along the view axis, inf = background; ray_depth float32 (H, W) distance from
         the camera centre; normals float32 (H, W, 3) world space,
@@ -175,5 +177,6 @@ class Scene:
         backend: Backend = "cpu",
         threads: Optional[int] = None,
         msaa: int = 1,
+        target: Literal["f32", "srgb8"] = "f32",
     ) -> List[Dict[str, np.ndarray]]:
         """`render` for every camera, the GIL released for the whole batch."""

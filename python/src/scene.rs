@@ -7,6 +7,7 @@ use kantele::backend::Backend;
 use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::error::RenderError;
 use kantele::multisample::SampleCount;
+use kantele::rop::TargetFormat;
 use kantele::scene::Scene;
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
@@ -57,7 +58,7 @@ impl PyScene {
 }
 
 /// Which backend renders, parsed from the `backend` argument.
-#[derive(Clone, Copy)]
+#[derive(Clone, Copy, PartialEq, Eq)]
 enum BackendKind {
     Cpu,
     Gl,
@@ -120,6 +121,19 @@ fn parse_msaa(msaa: i64) -> PyResult<SampleCount> {
         .map_err(|e| value_error(format!("msaa: {e}")))
 }
 
+/// The colour target: `"f32"` or `"srgb8"`, the latter for the CPU backend only.
+fn parse_target(target: &str, backend: BackendKind) -> PyResult<TargetFormat> {
+    let format: TargetFormat = target
+        .parse()
+        .map_err(|e: String| value_error(format!("target: {e}")))?;
+    if format != TargetFormat::LinearF32 && backend != BackendKind::Cpu {
+        return Err(value_error(format!(
+            "target='{target}' is a CPU backend option (the GL backend renders into f32)"
+        )));
+    }
+    Ok(format)
+}
+
 fn parse_threads(threads: Option<i64>) -> PyResult<Option<usize>> {
     match threads {
         None => Ok(None),
@@ -130,6 +144,7 @@ fn parse_threads(threads: Option<i64>) -> PyResult<Option<usize>> {
 
 impl PyScene {
     /// Renders the scene through `views` with the GIL released.
+    #[allow(clippy::too_many_arguments)]
     fn render_frames(
         &self,
         py: Python<'_>,
@@ -138,6 +153,7 @@ impl PyScene {
         backend: BackendKind,
         threads: Option<usize>,
         samples: SampleCount,
+        target: TargetFormat,
     ) -> PyResult<Vec<RenderedView>> {
         let scene = &self.scene;
         let cpu = &self.cpu;
@@ -157,6 +173,7 @@ impl PyScene {
                     }
                     let cached = cached.as_mut().expect("a backend was made above");
                     cached.backend.set_samples(samples)?;
+                    cached.backend.set_target(target);
                     render_views(&mut cached.backend, scene, &views, outputs)
                 }
                 BackendKind::Gl => {
@@ -382,9 +399,11 @@ impl PyScene {
     /// `camera=None` uses the scene's camera, `size=None` the scene's resolution. `msaa` is the
     /// samples per pixel of the colour outputs (1, 4 or 8, as `kantele render --msaa`; the GL
     /// backend offers what its driver does, llvmpipe 4): edges are antialiased, while depth,
-    /// normals and ids stay per pixel, equal to a 1× render's. The GIL is released while
+    /// normals and ids stay per pixel, equal to a 1× render's. `target` is the CPU backend's
+    /// colour target, `"f32"` or `"srgb8"` (as `kantele render --target`: 8-bit sRGB tiles, a
+    /// quarter of the colour memory, the same 8-bit colour). The GIL is released while
     /// rendering.
-    #[pyo3(signature = (camera = None, size = None, outputs = None, backend = "cpu", threads = None, msaa = 1))]
+    #[pyo3(signature = (camera = None, size = None, outputs = None, backend = "cpu", threads = None, msaa = 1, target = "f32"))]
     #[allow(clippy::too_many_arguments)]
     fn render<'py>(
         &self,
@@ -395,16 +414,25 @@ impl PyScene {
         backend: &str,
         threads: Option<i64>,
         msaa: i64,
+        target: &str,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let mut all =
-            self.render_many_impl(py, vec![camera], size, outputs, backend, threads, msaa)?;
+        let mut all = self.render_many_impl(
+            py,
+            vec![camera],
+            size,
+            outputs,
+            backend,
+            threads,
+            msaa,
+            target,
+        )?;
         view_dict(py, all.remove(0))
     }
 
     /// Renders every camera of `cameras` (a `None` entry is the scene's camera) and returns a
     /// list of dicts as [`render`] does. The scene is prepared once; the GIL is released for
     /// the whole batch.
-    #[pyo3(signature = (cameras, size = None, outputs = None, backend = "cpu", threads = None, msaa = 1))]
+    #[pyo3(signature = (cameras, size = None, outputs = None, backend = "cpu", threads = None, msaa = 1, target = "f32"))]
     #[allow(clippy::too_many_arguments)]
     fn render_many<'py>(
         &self,
@@ -415,8 +443,10 @@ impl PyScene {
         backend: &str,
         threads: Option<i64>,
         msaa: i64,
+        target: &str,
     ) -> PyResult<Bound<'py, PyList>> {
-        let all = self.render_many_impl(py, cameras, size, outputs, backend, threads, msaa)?;
+        let all =
+            self.render_many_impl(py, cameras, size, outputs, backend, threads, msaa, target)?;
         let list = PyList::empty(py);
         for view in all {
             list.append(view_dict(py, view)?)?;
@@ -447,6 +477,7 @@ impl PyScene {
         backend: &str,
         threads: Option<i64>,
         msaa: i64,
+        target: &str,
     ) -> PyResult<Vec<RenderedView>> {
         let outputs = match outputs {
             Some(o) => parse_outputs(&o)?,
@@ -460,7 +491,8 @@ impl PyScene {
         let backend = parse_backend(backend)?;
         let threads = parse_threads(threads)?;
         let samples = parse_msaa(msaa)?;
+        let target = parse_target(target, backend)?;
         let views = self.views(&cameras, size)?;
-        self.render_frames(py, views, &outputs, backend, threads, samples)
+        self.render_frames(py, views, &outputs, backend, threads, samples, target)
     }
 }

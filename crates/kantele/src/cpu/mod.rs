@@ -74,6 +74,11 @@ impl CpuBackend {
         self.renderer.set_timeout(timeout);
     }
 
+    /// How colour frames are stored from the next frame on (normals and ids always use `f32`).
+    pub fn set_target(&mut self, target: TargetFormat) {
+        self.target = target;
+    }
+
     /// The underlying renderer (framebuffer access).
     pub fn renderer(&self) -> &Renderer {
         &self.renderer
