@@ -25,6 +25,20 @@ pub fn reference_scenes() -> Option<PathBuf> {
     kantele_testkit::shared_dir("scenes")
 }
 
+/// The reference scenes' `.glb` files, sorted (at least the 18 of `../shared/scenes`), when
+/// this checkout has them (see [`reference_scenes`]).
+pub fn reference_scene_files() -> Option<Vec<PathBuf>> {
+    let dir = reference_scenes()?;
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .expect("read scenes")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "glb"))
+        .collect();
+    files.sort();
+    assert!(files.len() >= 18, "{} scenes", files.len());
+    Some(files)
+}
+
 /// A PNG of the given RGBA texels.
 pub fn png(width: u32, height: u32, rgba: &[u8]) -> Vec<u8> {
     let image = image::RgbaImage::from_raw(width, height, rgba.to_vec()).expect("size matches");
