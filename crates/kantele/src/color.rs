@@ -100,24 +100,23 @@ pub fn srgb8_encode_table() -> &'static [u32] {
     })
 }
 
-/// [`unorm8`]`(`[`linear_to_srgb`]`(c))` through [`srgb8_encode_table`] (the scalar form of the
-/// lane-wide encode of 8-bit targets).
-#[inline]
-pub fn encode_srgb8_by_table(c: f32) -> u8 {
-    if c.is_nan() {
-        return 0;
-    }
-    let bits = c.to_bits() as i32;
-    let table = srgb8_encode_table();
-    let index = ((bits >> 16) - srgb8_table::FIRST).clamp(0, table.len() as i32 - 1);
-    let entry = table[index as usize];
-    let step = (bits as u32 & 0xFFFF) >= (entry & 0x1_FFFF);
-    ((entry >> srgb8_table::BASE_SHIFT) + step as u32) as u8
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The scalar form of the 8-bit target's lane-wide encode: [`unorm8`]`(`[`linear_to_srgb`]`(c))`
+    /// through [`srgb8_encode_table`].
+    fn encode_srgb8_by_table(c: f32) -> u8 {
+        if c.is_nan() {
+            return 0;
+        }
+        let bits = c.to_bits() as i32;
+        let table = srgb8_encode_table();
+        let index = ((bits >> 16) - srgb8_table::FIRST).clamp(0, table.len() as i32 - 1);
+        let entry = table[index as usize];
+        let step = (bits as u32 & 0xFFFF) >= (entry & 0x1_FFFF);
+        ((entry >> srgb8_table::BASE_SHIFT) + step as u32) as u8
+    }
 
     /// The table encode equals the `powf` one on every bucket edge, one float either side of
     /// every step, special values and a sweep over every 61st float of `[0, 2]`.

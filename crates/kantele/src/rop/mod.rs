@@ -180,12 +180,7 @@ fn try_vec<T>(
     n: usize,
     mut make: impl FnMut() -> Result<T, RenderError>,
 ) -> Result<Vec<T>, RenderError> {
-    let mut v = Vec::new();
-    v.try_reserve_exact(n)
-        .map_err(|_| RenderError::OutOfMemory {
-            what: "render target",
-            bytes: n.saturating_mul(std::mem::size_of::<T>()),
-        })?;
+    let mut v = tile::reserved_vec(n)?;
     for _ in 0..n {
         v.push(make()?);
     }

@@ -17,7 +17,7 @@
 
 use glam::Vec4;
 
-use super::tile::{block_first_pixel, resolve, TileBuffer, TileState, ALL_BLOCKS};
+use super::tile::{block_first_pixel, filled_vec, resolve, TileBuffer, TileState, ALL_BLOCKS};
 use crate::color::{encode_rgba8, srgb8_encode_table, srgb8_table};
 use crate::error::RenderError;
 use crate::fixed::{BLOCK_SIZE, TILE_PIXELS, TILE_SIZE};
@@ -46,13 +46,11 @@ pub struct Srgb8Tile {
 impl Srgb8Tile {
     /// A tile with `samples` samples per pixel, cleared to transparent black and depth 1.
     pub(super) fn new(samples: SampleCount) -> Result<Self, RenderError> {
-        // An f32 tile made first gives the depth planes and the state of a new tile.
-        let f32_tile = TileBuffer::new(samples)?;
         Ok(Self {
-            color: super::tile::filled_vec(samples.count() * TILE_PIXELS, 0)?,
-            depth: f32_tile.depth,
+            color: filled_vec(samples.count() * TILE_PIXELS, 0)?,
+            depth: filled_vec(super::depth_planes(samples) * TILE_PIXELS, 1.0)?,
             samples: samples.count(),
-            state: f32_tile.state,
+            state: TileState::new(),
             clear_texel: (Vec4::ZERO, 0),
         })
     }
@@ -238,7 +236,7 @@ fn encode_srgb8_channel<L: Lanes>(lanes: L, c: L::F32, table: &[u32]) -> L::I32 
 /// [`encode_rgba8`]`(…, true)` per pixel): red, green and blue through the table of
 /// [`srgb8_table`], alpha rounded linearly.
 #[inline(always)]
-pub(crate) fn encode_srgb8_lanes<L: Lanes>(lanes: L, rgba: [L::F32; 4], table: &[u32]) -> L::I32 {
+fn encode_srgb8_lanes<L: Lanes>(lanes: L, rgba: [L::F32; 4], table: &[u32]) -> L::I32 {
     let [r, g, b, a] = rgba;
     let zero = lanes.splat_f32(0.0);
     let alpha = a.simd_eq(a).select_f32(a, zero);

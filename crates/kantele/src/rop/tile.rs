@@ -486,7 +486,7 @@ impl TileBuffer {
 
 impl TileState {
     /// The state of a new tile: depth 1 everywhere, nothing deferred.
-    fn new() -> Self {
+    pub(super) fn new() -> Self {
         Self {
             depth_bound: 1.0,
             depth_bound_exact: true,
@@ -571,13 +571,20 @@ pub(super) fn block_first_pixel(block: usize) -> usize {
 
 /// A vector of `n` copies of `value`, or an error instead of an abort when memory runs out.
 pub(super) fn filled_vec<T: Clone>(n: usize, value: T) -> Result<Vec<T>, RenderError> {
+    let mut v = reserved_vec(n)?;
+    v.resize(n, value);
+    Ok(v)
+}
+
+/// An empty vector with room for exactly `n` values, or an error instead of an abort when
+/// memory runs out.
+pub(super) fn reserved_vec<T>(n: usize) -> Result<Vec<T>, RenderError> {
     let mut v = Vec::new();
     v.try_reserve_exact(n)
         .map_err(|_| RenderError::OutOfMemory {
             what: "render target",
             bytes: n.saturating_mul(std::mem::size_of::<T>()),
         })?;
-    v.resize(n, value);
     Ok(v)
 }
 
