@@ -594,6 +594,17 @@ fn footprint2<L: Lanes>(d: [L::F32; 2], width: L::F32, height: L::F32) -> L::F32
     x * x + y * y
 }
 
+/// The coefficients of [`log2_normal`]'s `P(t)`, lowest degree first (`P(0) ≈ 1/ln 2`).
+pub(super) const LOG2_POLYNOMIAL: [f32; 7] = [
+    1.442_699_7,
+    -0.721_375_8,
+    0.480_465_38,
+    -0.358_963_73,
+    0.297_259_54,
+    -0.272_680_46,
+    0.170_623_42,
+];
+
 /// `log2 x` for positive normal `x`, from the exponent bits and a polynomial in `t = m − 1`
 /// with the mantissa `m` in `[√½, √2)`: `log2 m ≈ t · P(t)`, `P` of degree 6 fitted to
 /// `log2(1 + t) / t` on that interval (absolute error below 4e-7 in `f32`). No division: the
@@ -608,25 +619,16 @@ fn footprint2<L: Lanes>(d: [L::F32; 2], width: L::F32, height: L::F32) -> L::F32
 pub(super) fn log2_normal<L: Lanes>(x: L::F32) -> L::F32 {
     let lanes = x.lanes();
     let bits = x.to_bits();
-    let exponent = bits.shr_logical::<23>() - lanes.splat_i32(127);
-    let mantissa_bits = (bits & lanes.splat_i32(0x007f_ffff)) | lanes.splat_i32(0x3f80_0000);
-    let m = L::F32::from_bits(mantissa_bits);
-    // m in [1, 2): above √2, halve it (exact) and raise the exponent.
-    let high = m.simd_ge(lanes.splat_f32(std::f32::consts::SQRT_2));
-    let m = high.select_f32(m * lanes.splat_f32(0.5), m);
-    let exponent = high.select_i32(exponent + lanes.splat_i32(1), exponent);
+    // x = 2^e · m with m in [√½, √2): the exponent counted from the bits of √½ (`0x3f3504f3`,
+    // whose mantissa bits are those of √2 in `f32`), so that a mantissa at or above √2's moves
+    // to the next exponent, and m the bits less that exponent. The same e and m (bit for bit)
+    // as taking the mantissa in [1, 2) and halving it (exactly) at or above √2, in four integer
+    // steps instead of nine.
+    let exponent = (bits - lanes.splat_i32(0x3f35_04f3)).shr_arith::<23>();
+    let m = L::F32::from_bits(bits - exponent.shl::<23>());
     // Exact: `m` and 1 are within a factor of two.
     let t = m - lanes.splat_f32(1.0);
-    // P(t), lowest degree first (P(0) ≈ 1/ln 2).
-    const P: [f32; 7] = [
-        1.442_699_7,
-        -0.721_375_8,
-        0.480_465_38,
-        -0.358_963_73,
-        0.297_259_54,
-        -0.272_680_46,
-        0.170_623_42,
-    ];
+    const P: [f32; 7] = LOG2_POLYNOMIAL;
     // Estrin's scheme: pairs `P[k] + P[k+1]·t` combined with t² and t⁴, five dependent steps
     // instead of Horner's twelve (the row's critical path runs through this).
     // Splats written out, not a closure: a closure may be compiled out of line, without the

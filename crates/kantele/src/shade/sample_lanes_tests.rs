@@ -176,6 +176,59 @@ fn log2_polynomial_is_close_to_libm() {
     }
 }
 
+/// The reduction `x = 2^e · m`, `m` in `[√½, √2)`, is the one the sampler used before it was
+/// taken from the bits of √½: the mantissa in `[1, 2)`, halved with the exponent raised at or
+/// above √2. Both give the same `e` and `m` for every positive normal float whose mantissa
+/// bits are those of √2's or next to them, and for a sweep of the others; so `log2_normal`
+/// keeps its bits.
+#[test]
+fn log2_reduction_is_the_earlier_one() {
+    let earlier = |x: f32| -> (i32, f32) {
+        let bits = x.to_bits() as i32;
+        let exponent = (bits >> 23) - 127;
+        let m = f32::from_bits(((bits & 0x007f_ffff) | 0x3f80_0000) as u32);
+        if m >= std::f32::consts::SQRT_2 {
+            (exponent + 1, m * 0.5)
+        } else {
+            (exponent, m)
+        }
+    };
+    let now = |x: f32| -> (i32, f32) {
+        let bits = x.to_bits() as i32;
+        let exponent = bits.wrapping_sub(0x3f35_04f3) >> 23;
+        (
+            exponent,
+            f32::from_bits(bits.wrapping_sub(exponent << 23) as u32),
+        )
+    };
+    let sqrt2_mantissa = std::f32::consts::SQRT_2.to_bits() & 0x007f_ffff;
+    let mut rng = Rng(7);
+    for biased in 1u32..=254 {
+        let near = (sqrt2_mantissa - 4..sqrt2_mantissa + 4).chain([0, 1, 0x007f_ffff]);
+        let swept = (0..64).map(|_| rng.range(0.0, 8_388_607.0) as u32);
+        for mantissa in near.chain(swept) {
+            let x = f32::from_bits(biased << 23 | mantissa);
+            let (e0, m0) = earlier(x);
+            let (e1, m1) = now(x);
+            assert_eq!((e0, m0.to_bits()), (e1, m1.to_bits()), "{x:e}");
+        }
+    }
+    // The lane `log2` of one float per exponent, at its mantissa nearest √2, against the
+    // polynomial on the earlier reduction (same steps, plain `f32`).
+    for biased in 1u32..=254 {
+        let x = f32::from_bits(biased << 23 | sqrt2_mantissa);
+        let got = dispatch(Isa::Scalar, Log2([x; 8]))[0];
+        let (e, m) = earlier(x);
+        let t = m - 1.0;
+        const P: [f32; 7] = LOG2_POLYNOMIAL;
+        let (t2, t4) = (t * t, t * t * (t * t));
+        let low = (P[0] + P[1] * t) + t2 * (P[2] + P[3] * t);
+        let high = (P[4] + P[5] * t) + t2 * P[6];
+        let expected = e as f32 + t * (low + t4 * high);
+        assert_eq!(got.to_bits(), expected.to_bits(), "{x:e}");
+    }
+}
+
 /// The polynomial `log2` is at most 0 exactly when its argument is at most 1 (the sampler
 /// skips the level of detail of magnified lanes on it): over the 2^21 floats on each side of
 /// 1 and the 2^13 on each side of every power of two.
