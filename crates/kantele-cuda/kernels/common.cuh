@@ -12,7 +12,8 @@
     !defined(KANTELE_GUARD_BAND_PIXELS) || !defined(KANTELE_SUBPIXEL_LIMIT) ||              \
     !defined(KANTELE_W_EPSILON) || !defined(KANTELE_MAX_CLIPPED_VERTICES) ||                \
     !defined(KANTELE_VARYINGS) || !defined(KANTELE_TRIANGLE_SETUP_SIZE) ||                  \
-    !defined(KANTELE_DRAW_RECORD_SIZE) || !defined(KANTELE_BIN_CHUNK)
+    !defined(KANTELE_DRAW_RECORD_SIZE) || !defined(KANTELE_BIN_CHUNK) ||                    \
+    !defined(KANTELE_SMALL_BOX_PIXELS)
 #error "Kantele kernels are compiled with the -D defines generated from the Rust core"
 #endif
 
@@ -482,6 +483,22 @@ __device__ int setup_triangle(const FrameUniforms& f, const V4 pos_clip[3], bool
     bbox.x1 = min(bbox.x1, (int)f.width);
     bbox.y1 = min(bbox.y1, (int)f.height);
     if (bbox.x0 >= bbox.x1 || bbox.y0 >= bbox.y1) return SETUP_DEGENERATE;
+    // A box of a few pixel centres, none covered: nothing to draw (the core's rule).
+    if ((i64)(bbox.x1 - bbox.x0) * (i64)(bbox.y1 - bbox.y0) <= KANTELE_SMALL_BOX_PIXELS) {
+        bool covered = false;
+        for (int y = bbox.y0; y < bbox.y1 && !covered; ++y) {
+            for (int x = bbox.x0; x < bbox.x1 && !covered; ++x) {
+                bool inside = true;
+                for (int e = 0; e < 3; ++e) {
+                    const EdgeFunction& ef = t.edges[e];
+                    inside = inside &&
+                             ef.a * pixel_center(x) + ef.b * pixel_center(y) + ef.c + ef.bias >= 0;
+                }
+                covered = inside;
+            }
+        }
+        if (!covered) return SETUP_DEGENERATE;
+    }
     t.area2 = area2;
     t.bbox = bbox;
     for (int i = 0; i < 3; ++i) {

@@ -45,6 +45,7 @@ pub fn defines() -> Vec<(String, String)> {
     int("KANTELE_TILE_LOG2", fixed::TILE_LOG2 as i64);
     int("KANTELE_BLOCK_LOG2", fixed::BLOCK_LOG2 as i64);
     int("KANTELE_SUBPIXEL_LIMIT", fixed::SUBPIXEL_LIMIT);
+    int("KANTELE_SMALL_BOX_PIXELS", kantele::setup::SMALL_BOX_PIXELS);
     int("KANTELE_MAX_CLIPPED_VERTICES", MAX_CLIPPED_VERTICES as i64);
     int("KANTELE_VARYINGS", MATERIAL_VARYINGS as i64);
     int("KANTELE_BIN_CHUNK", BIN_CHUNK as i64);

@@ -175,7 +175,8 @@ const _: () = {
 pub enum SetupReject {
     /// Removed by face culling.
     Culled,
-    /// Zero area after snapping, or no pixel centre inside its box on the target.
+    /// Zero area after snapping, no pixel centre inside its box on the target, or (1×) none
+    /// of the few centres in a small box covered.
     Degenerate,
 }
 
@@ -297,6 +298,18 @@ pub fn setup_triangle(
     setup_window_triangle(viewport, window, cull, front_face)
 }
 
+/// Whether the three edges of a triangle cover the centre of pixel `(x, y)` (top-left rule
+/// included): [`TriangleSetup::covers`], before the record exists.
+#[inline]
+fn edges_cover(edges: &[EdgeFunction; 3], x: i32, y: i32) -> bool {
+    edges.iter().all(|e| e.biased_at_pixel(x, y) >= 0)
+}
+
+/// Pixel centres in a triangle's box, at most, for which setup tests each centre's coverage and
+/// drops a triangle that covers none (see [`setup_window_triangle`]; the CUDA kernels' setup
+/// applies the same rule).
+pub const SMALL_BOX_PIXELS: i64 = 4;
+
 /// Sets up one triangle from its window-space vertices ([`Viewport::window_vertex`] of positions
 /// with `w > 0` inside the guard band): the same record as [`setup_triangle`].
 #[inline]
@@ -361,6 +374,17 @@ pub fn setup_window_triangle(
     if bbox.is_empty() {
         return Err(SetupReject::Degenerate);
     }
+    // A triangle whose box holds only a few pixel centres, none of them covered, draws nothing
+    // (1×; under multisampling the box reaches further than the centres). A far mesh has many
+    // such triangles; dropped here, each costs no setup record, no bin entry and no raster
+    // call. The test is the rasterizer's own (`TriangleSetup::covers`).
+    if reach == 0 && i64::from(bbox.width()) * i64::from(bbox.height()) <= SMALL_BOX_PIXELS {
+        let covered =
+            (bbox.y0..bbox.y1).any(|y| (bbox.x0..bbox.x1).any(|x| edges_cover(&edges, x, y)));
+        if !covered {
+            return Err(SetupReject::Degenerate);
+        }
+    }
     let depth = [v0.depth, v1.depth, v2.depth];
     let area_f = area2 as f32;
     Ok(TriangleSetup {
@@ -408,7 +432,7 @@ impl TriangleSetup {
     /// Whether the centre of pixel `(x, y)` is covered (top-left rule included).
     #[inline]
     pub fn covers(&self, x: i32, y: i32) -> bool {
-        self.edges.iter().all(|e| e.biased_at_pixel(x, y) >= 0)
+        edges_cover(&self.edges, x, y)
     }
 
     /// Screen-space barycentric weights `λ_i = E_i / area2` at the centre of pixel `(x, y)`,
@@ -503,6 +527,62 @@ mod tests {
         assert_eq!(
             setup_triangle(&vp, line, CullMode::None, FrontFace::Ccw),
             Err(SetupReject::Degenerate)
+        );
+    }
+
+    /// Setup drops a small triangle exactly when it covers no pixel centre: checked against the
+    /// same triangle set up for a 4× target, whose box reaches further so nothing is dropped,
+    /// over every small triangle with vertices on a quarter-pixel grid near a few centres.
+    #[test]
+    fn small_triangles_are_dropped_exactly_when_they_cover_no_centre() {
+        let one = Viewport::new(8, 8);
+        let four = one.with_samples(crate::multisample::SampleCount::X4);
+        let vertex = |k: u32| -> WindowVertex {
+            // 0..=8 quarter pixels from (2.25, 2.25) in x and y.
+            let (x, y) = (2.25 + 0.25 * (k % 9) as f32, 2.25 + 0.25 * (k / 9) as f32);
+            WindowVertex::snapped([x, y, 0.5], 1.0)
+        };
+        let (mut dropped, mut kept_small) = (0, 0);
+        for a in 0..81 {
+            for b in 0..81 {
+                for c in (0..81).step_by(7) {
+                    let window = [vertex(a), vertex(b), vertex(c)];
+                    let reference =
+                        setup_window_triangle(&four, window, CullMode::None, FrontFace::Ccw);
+                    let result =
+                        setup_window_triangle(&one, window, CullMode::None, FrontFace::Ccw);
+                    let Ok(reference) = reference else {
+                        assert_eq!(result, reference, "{a} {b} {c}");
+                        continue;
+                    };
+                    let covered = (reference.bbox.y0..reference.bbox.y1)
+                        .flat_map(|y| (reference.bbox.x0..reference.bbox.x1).map(move |x| (x, y)))
+                        .filter(|&(x, y)| reference.covers(x, y))
+                        .count();
+                    match result {
+                        Ok(t) => {
+                            let area = i64::from(t.bbox.width() * t.bbox.height());
+                            assert!(covered > 0 || area > SMALL_BOX_PIXELS);
+                            let with_reach = TriangleSetup {
+                                bbox: reference.bbox,
+                                ..t
+                            };
+                            assert_eq!(with_reach, reference, "{a} {b} {c}");
+                            kept_small += (area <= SMALL_BOX_PIXELS) as u32;
+                        }
+                        Err(reject) => {
+                            assert_eq!(reject, SetupReject::Degenerate, "{a} {b} {c}");
+                            assert_eq!(covered, 0, "{a} {b} {c}: dropped, covers {covered}");
+                            dropped += 1;
+                        }
+                    }
+                }
+            }
+        }
+        // Both outcomes occur.
+        assert!(
+            dropped > 100 && kept_small > 100,
+            "{dropped} dropped, {kept_small} kept"
         );
     }
 
