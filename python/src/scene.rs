@@ -142,19 +142,60 @@ fn parse_threads(threads: Option<i64>) -> PyResult<Option<usize>> {
     }
 }
 
+/// How `render` and `render_many` render, parsed once from their keyword arguments.
+struct RenderSettings {
+    outputs: Vec<OutputKind>,
+    backend: BackendKind,
+    threads: Option<usize>,
+    samples: SampleCount,
+    target: TargetFormat,
+}
+
+impl RenderSettings {
+    /// The settings from the Python arguments (`outputs=None`: every output), checked in the
+    /// order they are declared.
+    fn parse(
+        outputs: Option<&Bound<'_, PyAny>>,
+        backend: &str,
+        threads: Option<i64>,
+        msaa: i64,
+        target: &str,
+    ) -> PyResult<Self> {
+        let outputs = match outputs {
+            Some(o) => parse_outputs(o)?,
+            None => vec![
+                OutputKind::Color,
+                OutputKind::Depth,
+                OutputKind::Normals,
+                OutputKind::Ids,
+            ],
+        };
+        let backend = parse_backend(backend)?;
+        Ok(Self {
+            outputs,
+            backend,
+            threads: parse_threads(threads)?,
+            samples: parse_msaa(msaa)?,
+            target: parse_target(target, backend)?,
+        })
+    }
+}
+
 impl PyScene {
     /// Renders the scene through `views` with the GIL released.
-    #[allow(clippy::too_many_arguments)]
     fn render_frames(
         &self,
         py: Python<'_>,
         views: Vec<CameraPose>,
-        outputs: &[OutputKind],
-        backend: BackendKind,
-        threads: Option<usize>,
-        samples: SampleCount,
-        target: TargetFormat,
+        settings: &RenderSettings,
     ) -> PyResult<Vec<RenderedView>> {
+        let RenderSettings {
+            ref outputs,
+            backend,
+            threads,
+            samples,
+            target,
+        } = *settings;
         let scene = &self.scene;
         let cpu = &self.cpu;
         let result = py.detach(|| -> Result<Vec<RenderedView>, RenderError> {
@@ -416,16 +457,9 @@ impl PyScene {
         msaa: i64,
         target: &str,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let mut all = self.render_many_impl(
-            py,
-            vec![camera],
-            size,
-            outputs,
-            backend,
-            threads,
-            msaa,
-            target,
-        )?;
+        let settings = RenderSettings::parse(outputs.as_ref(), backend, threads, msaa, target)?;
+        let views = self.views(&[camera], size)?;
+        let mut all = self.render_frames(py, views, &settings)?;
         view_dict(py, all.remove(0))
     }
 
@@ -445,8 +479,9 @@ impl PyScene {
         msaa: i64,
         target: &str,
     ) -> PyResult<Bound<'py, PyList>> {
-        let all =
-            self.render_many_impl(py, cameras, size, outputs, backend, threads, msaa, target)?;
+        let settings = RenderSettings::parse(outputs.as_ref(), backend, threads, msaa, target)?;
+        let views = self.views(&cameras, size)?;
+        let all = self.render_frames(py, views, &settings)?;
         let list = PyList::empty(py);
         for view in all {
             list.append(view_dict(py, view)?)?;
@@ -463,36 +498,5 @@ impl PyScene {
             self.scene.resolution.0,
             self.scene.resolution.1
         )
-    }
-}
-
-impl PyScene {
-    #[allow(clippy::too_many_arguments)]
-    fn render_many_impl<'py>(
-        &self,
-        py: Python<'py>,
-        cameras: Vec<Option<PyCamera>>,
-        size: Option<(i64, i64)>,
-        outputs: Option<Bound<'py, PyAny>>,
-        backend: &str,
-        threads: Option<i64>,
-        msaa: i64,
-        target: &str,
-    ) -> PyResult<Vec<RenderedView>> {
-        let outputs = match outputs {
-            Some(o) => parse_outputs(&o)?,
-            None => vec![
-                OutputKind::Color,
-                OutputKind::Depth,
-                OutputKind::Normals,
-                OutputKind::Ids,
-            ],
-        };
-        let backend = parse_backend(backend)?;
-        let threads = parse_threads(threads)?;
-        let samples = parse_msaa(msaa)?;
-        let target = parse_target(target, backend)?;
-        let views = self.views(&cameras, size)?;
-        self.render_frames(py, views, &outputs, backend, threads, samples, target)
     }
 }
