@@ -21,13 +21,6 @@ extern "C" __global__ void kantele_clear(FrameUniforms f, float4* color, float* 
     depth[i] = 1.0f;
 }
 
-__device__ __forceinline__ bool covers(const TriangleSetup& t, int x, int y) {
-    for (int e = 0; e < 3; ++e) {
-        const EdgeFunction& ef = t.edges[e];
-        if (ef.a * pixel_center(x) + ef.b * pixel_center(y) + ef.c + ef.bias < 0) return false;
-    }
-    return true;
-}
 
 // ocot: the grid covers `setups[ref].bbox` from its top-left corner.
 extern "C" __global__ void kantele_ocot_triangle(FrameUniforms f, SceneView s,

@@ -248,6 +248,15 @@ __device__ __forceinline__ i64 snap(float window) {
 
 __device__ __forceinline__ i64 pixel_center(i64 p) { return p * SUBPIXEL_ONE + SUBPIXEL_HALF; }
 
+// `TriangleSetup::covers`: the centre of pixel (x, y) is covered (top-left rule included).
+__device__ __forceinline__ bool covers(const TriangleSetup& t, int x, int y) {
+    for (int e = 0; e < 3; ++e) {
+        const EdgeFunction& ef = t.edges[e];
+        if (ef.a * pixel_center(x) + ef.b * pixel_center(y) + ef.c + ef.bias < 0) return false;
+    }
+    return true;
+}
+
 // `i64::div_euclid` for a positive divisor.
 __device__ __forceinline__ i64 floor_div(i64 a, i64 b) {
     i64 q = a / b;
@@ -487,15 +496,7 @@ __device__ int setup_triangle(const FrameUniforms& f, const V4 pos_clip[3], bool
     if ((i64)(bbox.x1 - bbox.x0) * (i64)(bbox.y1 - bbox.y0) <= KANTELE_SMALL_BOX_PIXELS) {
         bool covered = false;
         for (int y = bbox.y0; y < bbox.y1 && !covered; ++y) {
-            for (int x = bbox.x0; x < bbox.x1 && !covered; ++x) {
-                bool inside = true;
-                for (int e = 0; e < 3; ++e) {
-                    const EdgeFunction& ef = t.edges[e];
-                    inside = inside &&
-                             ef.a * pixel_center(x) + ef.b * pixel_center(y) + ef.c + ef.bias >= 0;
-                }
-                covered = inside;
-            }
+            for (int x = bbox.x0; x < bbox.x1 && !covered; ++x) covered = covers(t, x, y);
         }
         if (!covered) return SETUP_DEGENERATE;
     }
