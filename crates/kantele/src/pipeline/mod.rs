@@ -23,6 +23,7 @@ mod points_lines;
 mod sanitize;
 mod shader;
 mod warm;
+mod workers;
 
 use std::sync::atomic::AtomicBool;
 use std::sync::Arc;
@@ -35,6 +36,7 @@ pub use self::shader::{
     FnShader, Fragment, FragmentLanes, LaneProgram, LaneProgramJob, ShadedLanes, Shader,
     ShaderLanes,
 };
+pub use self::workers::PIN_ENV;
 pub use crate::state::{RenderState, Topology};
 
 use self::budget::FrameBudget;
@@ -72,6 +74,12 @@ pub struct RendererOptions {
     /// quarter of the colour memory; the same 8-bit picture for a frame that starts with a
     /// clear, see [`TargetFormat`]).
     pub target: TargetFormat,
+    /// Whether each worker is pinned to its own CPU (one of those the creating thread may run
+    /// on; a pool with more workers than such CPUs is not pinned): `None` (the default) reads
+    /// [`PIN_ENV`] (`1` pins), `Some(false)` never pins. Pinning keeps workers apart where
+    /// the system would put several on one CPU, and costs where other busy threads need the
+    /// CPUs (a pinned worker cannot move away from them). It never changes the picture.
+    pub pin_workers: Option<bool>,
 }
 
 /// The CPU renderer: owns the framebuffer and the worker threads.
@@ -98,14 +106,12 @@ impl Renderer {
     /// A renderer with a `width × height` target (each side 1..=[`MAX_TARGET_SIZE`]).
     pub fn new(width: u32, height: u32, options: RendererOptions) -> Result<Self, RenderError> {
         check_target_size(width, height)?;
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(options.threads.unwrap_or(0))
-            .thread_name(|i| format!("kantele-worker-{i}"))
-            .build()
-            .map_err(|e| RenderError::Backend {
+        let pool = workers::worker_pool(options.threads, options.pin_workers).map_err(|e| {
+            RenderError::Backend {
                 backend: "cpu".into(),
                 message: format!("cannot start worker threads: {e}"),
-            })?;
+            }
+        })?;
         let framebuffer = Framebuffer::band(
             width,
             height,
