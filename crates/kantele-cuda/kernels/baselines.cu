@@ -21,7 +21,6 @@ extern "C" __global__ void kantele_clear(FrameUniforms f, float4* color, float* 
     depth[i] = 1.0f;
 }
 
-
 // ocot: the grid covers `setups[ref].bbox` from its top-left corner.
 extern "C" __global__ void kantele_ocot_triangle(FrameUniforms f, SceneView s,
                                                  const TriangleSetup* setups,
