@@ -347,6 +347,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                         "triangles": row.triangles, "draws": row.draws,
                         "backend": row.backend, "renderer": row.renderer, "threads": row.threads, "isa": row.isa, "target": row.target, "msaa": row.msaa,
                         "frames": args.frames, "warmup": args.warmup,
+                        // How this binary was compiled (build.rs): figures name their build.
+                        "build": env!("KANTELE_BUILD"),
                         "median_ms": median, "min_ms": min, "max_ms": max,
                         "geometry_ms": stages.map(|s| s.geometry),
                         "binning_ms": stages.map(|s| s.binning),

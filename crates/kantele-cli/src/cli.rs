@@ -13,7 +13,12 @@ use kantele::rop::TargetFormat;
 /// Errors are reported as one line `kantele: error: <file>: <problem>` on stderr with exit
 /// status 2 (`compare` exits with 1 when a tolerance is broken).
 #[derive(Debug, Parser)]
-#[command(name = "kantele", version, about, long_about)]
+#[command(
+    name = "kantele",
+    version = concat!(env!("CARGO_PKG_VERSION"), " (", env!("KANTELE_BUILD"), ")"),
+    about,
+    long_about
+)]
 pub struct Cli {
     /// What to do.
     #[command(subcommand)]

@@ -55,6 +55,14 @@ fn bench_two_frames() {
     let v: serde_json::Value = serde_json::from_str(lines[0]).unwrap();
     assert_eq!(v["backend"], "cpu");
     assert_eq!(v["frames"], 2);
+    // The build the figures came from: the tests' profile, not profile-guided.
+    let build = v["build"]
+        .as_str()
+        .unwrap_or_else(|| panic!("build in {out}"));
+    assert!(
+        build.starts_with("opt-level ") && !build.contains("profile-guided"),
+        "{out}"
+    );
     assert!(v["median_ms"].as_f64().unwrap() > 0.0);
     assert!(v["min_ms"].as_f64().unwrap() <= v["max_ms"].as_f64().unwrap());
     // The CPU backend times its stages: medians within the slowest frame, the raster's not 0
@@ -80,4 +88,15 @@ fn bench_two_frames() {
     ]);
     ok(&o);
     assert!(stdout(&o).contains("median"));
+}
+
+#[test]
+fn version_names_the_build() {
+    let o = kantele(&["--version"]);
+    ok(&o);
+    let out = stdout(&o);
+    assert!(
+        out.starts_with("kantele ") && out.contains("(opt-level "),
+        "{out}"
+    );
 }
