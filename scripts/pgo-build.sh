@@ -41,15 +41,15 @@ awk 'BEGIN { n = 0; split("1 3 4 2|5 6 8 7|1 2 6 5|3 7 8 4|1 5 7 3|2 4 8 6", sid
         n++ } }' >"$out/training-cubes.obj"
 scenes=(--builtin cube --builtin teapot --builtin ground --builtin pixel-edges
     "$out/training-cubes.obj")
-levels=(scalar)
-case $(uname -m) in
-    x86_64)
-        levels+=(sse2)
-        grep -qw avx2 /proc/cpuinfo && levels+=(avx2)
-        grep -qw avx512vl /proc/cpuinfo && levels+=(avx512)
-        ;;
-    aarch64) levels+=(neon) ;;
-esac
+# The instruction-set levels this CPU has, as the renderer itself decides (`Isa::supported`):
+# it replaces a level the CPU lacks by its best one, and `bench --json` names the level used.
+levels=()
+for isa in scalar sse2 sse41 avx2 avx512 neon; do
+    used=$(KANTELE_ISA=$isa "$kantele" bench --builtin pixel-edges --frames 1 --warmup 0 --json)
+    if [[ $used == *"\"isa\":\"$isa\""* ]]; then
+        levels+=("$isa")
+    fi
+done
 for isa in "${levels[@]}"; do
     # The scalar level is the readable reference, slow when instrumented: fewer frames.
     frames=10
