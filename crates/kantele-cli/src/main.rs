@@ -90,6 +90,22 @@ fn usage_error_line(text: &str) -> String {
     format!("{} (see kantele --help)", one_line(&message))
 }
 
+/// Reports `KANTELE_ISA`, which the renderer reads without complaint: a value that names no
+/// instruction-set level is an error; a level this CPU lacks gets a warning, and the renderer
+/// uses its best level instead (the `isa` column of `bench` says which).
+fn check_isa_env() -> Result<(), String> {
+    use kantele::simd::Isa;
+    if let Some(forced) = Isa::from_env()? {
+        if !forced.is_supported() {
+            eprintln!(
+                "kantele: warning: KANTELE_ISA={forced}: this CPU does not support it; using {}",
+                Isa::best()
+            );
+        }
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
@@ -106,6 +122,10 @@ fn main() -> ExitCode {
             return ExitCode::from(EXIT_ERROR);
         }
     };
+    if let Err(message) = check_isa_env() {
+        eprintln!("kantele: error: {message}");
+        return ExitCode::from(EXIT_ERROR);
+    }
     let result = match cli.command {
         Command::Render(args) => render_cmd::run(&args).map(|()| true),
         Command::Info(args) => info::run(&args).map(|()| true),

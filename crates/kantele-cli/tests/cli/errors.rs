@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use crate::common::{kantele, ok, stderr, stdout, TempDir};
+use crate::common::{kantele, kantele_with_env, ok, stderr, stdout, TempDir};
 use crate::{assert_clean_failure, shared_scenes};
 
 #[test]
@@ -201,4 +201,31 @@ fn a_frame_over_its_time_budget_fails_cleanly() {
     ]);
     assert!(!o.status.success());
     assert!(stderr(&o).contains("timeout"), "{}", stderr(&o));
+}
+
+#[test]
+fn kantele_isa_is_checked() {
+    let dir = TempDir::new("isa");
+    let out = dir.s("cube.png");
+    let args = ["render", "--builtin", "cube", "--size", "64x48", "-o", &out];
+    // A value that names no level: one clean line, nothing written.
+    let o = kantele_with_env(&args, "KANTELE_ISA", "mmx");
+    assert_clean_failure(&o, "KANTELE_ISA: unknown instruction set `mmx`", &dir, &[]);
+    // A level this CPU lacks: a warning, and the picture from the best level.
+    let missing = if cfg!(target_arch = "aarch64") {
+        "avx2"
+    } else {
+        "neon"
+    };
+    let o = kantele_with_env(&args, "KANTELE_ISA", missing);
+    ok(&o);
+    let warning = format!("kantele: warning: KANTELE_ISA={missing}: this CPU does not support it");
+    assert!(stderr(&o).contains(&warning), "{}", stderr(&o));
+    assert!(dir.path("cube.png").is_file());
+    // A supported level, and an empty value (no override): no warning.
+    for value in ["scalar", ""] {
+        let o = kantele_with_env(&args, "KANTELE_ISA", value);
+        ok(&o);
+        assert!(!stderr(&o).contains("KANTELE_ISA"), "{}", stderr(&o));
+    }
 }

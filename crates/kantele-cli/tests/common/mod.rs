@@ -48,6 +48,15 @@ pub fn kantele(args: &[&str]) -> Output {
     Command::new(BIN).args(args).output().expect("run kantele")
 }
 
+/// Runs the binary with `args` and the environment variable `name` set to `value`.
+pub fn kantele_with_env(args: &[&str], name: &str, value: &str) -> Output {
+    Command::new(BIN)
+        .args(args)
+        .env(name, value)
+        .output()
+        .expect("run kantele")
+}
+
 /// Standard error as text.
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
