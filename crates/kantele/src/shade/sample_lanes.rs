@@ -27,7 +27,9 @@ use crate::simd::{
 
 use super::texel::{linear15_table, LINEAR15_SCALE};
 use super::texel_lanes::{Channels, TexelSource};
-use super::texture::{ColorSpace, Filter, Linear15Copy, MinFilter, Sampler, Texture, Wrap};
+use super::texture::{
+    ColorSpace, Filter, LaneTable, Linear15Copy, MinFilter, Sampler, Texture, Wrap,
+};
 
 impl Texture {
     /// Samples eight texture coordinates at once, each with the level of detail from its own
@@ -98,11 +100,11 @@ impl Texture {
     fn level_layout<'t>(&'t self, source: TexelSource<'t>) -> LevelLayout<'t> {
         match source {
             TexelSource::Linear15(copy) => LevelLayout {
-                offsets: &copy.offsets,
+                lane_offsets: &copy.lane_offsets,
                 row_padding: 1,
             },
             TexelSource::LinearBytes(_) | TexelSource::SrgbBytes(..) => LevelLayout {
-                offsets: &self.levels.offsets,
+                lane_offsets: &self.levels.lane_offsets,
                 row_padding: 0,
             },
         }
@@ -200,7 +202,7 @@ impl Texture {
         live: MaskOf<L>,
     ) -> LevelTexels<L> {
         let lanes = nearest.lanes();
-        let (offset, width, height) = self.level_extents::<L>(layout, level, live);
+        let (offset, width, height) = self.level_extents::<L>(layout, level);
         let row_length = width + lanes.splat_i32(layout.row_padding);
         let s = LaneAxis::<L>::new(sampler.wrap_s, uv[0], width);
         let t = LaneAxis::<L>::new(sampler.wrap_t, uv[1], height);
@@ -245,35 +247,20 @@ impl Texture {
         }
     }
 
-    /// Each lane's level offset (in `layout`), width and height: one splat when every `live`
-    /// lane reads the same level (the common case), else gathered per lane.
+    /// Each lane's level offset (in `layout`), width and height, looked up in the
+    /// [`LaneTable`]s: no branch on whether the lanes share a level, no gather.
     #[inline(always)]
     fn level_extents<L: Lanes>(
         &self,
         layout: LevelLayout<'_>,
         level: L::I32,
-        live: MaskOf<L>,
     ) -> (L::I32, L::I32, L::I32) {
-        let lanes = live.lanes();
-        let first_live = (live.bits().trailing_zeros() as usize).min(7);
-        let first_level = level.extract(first_live);
-        let same = level
-            .simd_eq(lanes.splat_i32(first_level))
-            .or(live.not())
-            .all();
-        let table = &self.levels;
-        match usize::try_from(first_level) {
-            Ok(index) if same && index < layout.offsets.len() => (
-                lanes.splat_i32(layout.offsets[index] as i32),
-                lanes.splat_i32(table.widths[index] as i32),
-                lanes.splat_i32(table.heights[index] as i32),
-            ),
-            _ => (
-                level.gather_u32(layout.offsets),
-                level.gather_u32(&table.widths),
-                level.gather_u32(&table.heights),
-            ),
-        }
+        let [widths, heights] = &self.levels.lane_sizes;
+        (
+            lookup16::<L>(layout.lane_offsets, level),
+            lookup16::<L>(widths, level),
+            lookup16::<L>(heights, level),
+        )
     }
 }
 
@@ -374,12 +361,23 @@ fn lod_lanes<L: Lanes>(sizes: Sizes, rho2: L::F32) -> L::F32 {
     normal.select_f32(lod, fallback)
 }
 
+/// Lane `k`: `table[index[k] mod 16]`, without a branch or a memory access per lane (two
+/// permutes of eight entries and a select; the values move as bits).
+#[inline(always)]
+fn lookup16<L: Lanes>(table: &LaneTable, index: L::I32) -> L::I32 {
+    let lanes = index.lanes();
+    let low = L::F32::from_bits(lanes.load_i32(&table[..8])).permute(index);
+    let high = L::F32::from_bits(lanes.load_i32(&table[8..])).permute(index);
+    let in_high = (index & lanes.splat_i32(8)).simd_eq(lanes.splat_i32(8));
+    in_high.select_f32(high, low).to_bits()
+}
+
 /// Where a texel source holds each level: the index of its first texel, and rows of `width +
 /// row_padding` texels.
 #[derive(Clone, Copy)]
 struct LevelLayout<'t> {
-    /// Index of each level's first texel, level 0 first.
-    offsets: &'t [u32],
+    /// Index of each level's first texel, level 0 first, as a [`LaneTable`].
+    lane_offsets: &'t LaneTable,
     /// 0 (the texel storage), or 1 (a [`Linear15Copy`]: each row ends with a copy of its first
     /// texel).
     row_padding: i32,

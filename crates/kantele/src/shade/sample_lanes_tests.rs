@@ -450,3 +450,68 @@ fn inactive_lanes_are_not_sampled() {
     );
     assert_eq!(got, [[0.0; 8]; 4]);
 }
+
+/// Each lane's level offset and size through [`Texture::level_extents`].
+struct Extents<'a> {
+    texture: &'a Texture,
+    source: TexelSource<'a>,
+    levels: [i32; 8],
+}
+
+impl LaneKernel for Extents<'_> {
+    type Output = [[i32; 8]; 3];
+    #[inline(always)]
+    fn run<L: Lanes>(self, lanes: L) -> [[i32; 8]; 3] {
+        let layout = self.texture.level_layout(self.source);
+        let level = lanes.i32_from_array(self.levels);
+        let (offset, width, height) = self.texture.level_extents::<L>(layout, level);
+        [offset.to_array(), width.to_array(), height.to_array()]
+    }
+}
+
+/// The level tables looked up lane-wide give every level's offset (in the bytes and in the
+/// decoded copy) and size, in any mix of levels per row, on every instruction set; the
+/// tables repeat the last level past it.
+#[test]
+fn level_extents_are_the_level_table() {
+    // 512 × 8: ten levels, the height clamped at 1 from level 3 on.
+    let texture = noise_texture(512, 8, ColorSpace::Srgb);
+    let copy = texture.linear15().expect("decoded copy");
+    let count = texture.level_count();
+    assert_eq!(count, 10);
+    let expected = |source_is_copy: bool, level: usize| {
+        let l = level.min(count - 1);
+        let offset = if source_is_copy {
+            copy.offsets[l]
+        } else {
+            texture.levels.offsets[l]
+        };
+        [
+            offset as i32,
+            texture.levels.widths[l] as i32,
+            texture.levels.heights[l] as i32,
+        ]
+    };
+    for isa in Isa::ALL.into_iter().filter(|isa| isa.is_supported()) {
+        for first in 0..16 {
+            let levels: [i32; 8] = std::array::from_fn(|k| ((first + 3 * k) % 16) as i32);
+            for (is_copy, source) in [
+                (true, TexelSource::Linear15(copy)),
+                (false, TexelSource::LinearBytes(&texture.texels)),
+            ] {
+                let got = dispatch(
+                    isa,
+                    Extents {
+                        texture: &texture,
+                        source,
+                        levels,
+                    },
+                );
+                for (k, &level) in levels.iter().enumerate() {
+                    let lane = [got[0][k], got[1][k], got[2][k]];
+                    assert_eq!(lane, expected(is_copy, level as usize), "{isa} lane {k}");
+                }
+            }
+        }
+    }
+}

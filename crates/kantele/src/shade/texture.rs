@@ -73,8 +73,8 @@ impl MipLevel<'_> {
     }
 }
 
-/// Where each mip level lies in the texel storage, one entry per level (level 0 first). Kept as
-/// three arrays so the lane-wide sampler can gather a lane's level offset and size.
+/// Where each mip level lies in the texel storage, one entry per level (level 0 first), and
+/// the same as [`LaneTable`]s for the lane-wide sampler.
 #[derive(Clone, Debug, Default)]
 pub(super) struct LevelTable {
     /// Index of each level's first texel.
@@ -83,6 +83,30 @@ pub(super) struct LevelTable {
     pub(super) widths: Vec<u32>,
     /// Height of each level in texels.
     pub(super) heights: Vec<u32>,
+    /// The offsets as a [`LaneTable`].
+    pub(super) lane_offsets: LaneTable,
+    /// The widths and heights as [`LaneTable`]s.
+    pub(super) lane_sizes: [LaneTable; 2],
+}
+
+/// The per-level values of a mip chain (at most 16 levels: [`MAX_TEXTURE_SIZE`] has 15) in the
+/// form the lane-wide sampler looks them up, two 8-lane permutes: the values of levels
+/// `0..16`, the last level's repeated past the last level.
+pub(super) type LaneTable = [i32; 16];
+
+const _: () = assert!(
+    MAX_TEXTURE_SIZE.ilog2() < 16,
+    "a mip chain must fit a LaneTable"
+);
+
+/// `values` (one per level, at most 16, each below 2³¹: offsets of at most 16384² · 4/3
+/// texels, sizes of at most 16384) as a [`LaneTable`].
+pub(super) fn lane_table(values: &[u32]) -> LaneTable {
+    let last = values.last().copied().unwrap_or(0);
+    std::array::from_fn(|k| {
+        let value = values.get(k).copied().unwrap_or(last);
+        i32::try_from(value).unwrap_or(i32::MAX)
+    })
 }
 
 /// A 2D texture with its complete mip chain, stored as packed RGBA8.
@@ -110,6 +134,8 @@ pub(super) struct Linear15Copy {
     pub(super) words: Vec<u32>,
     /// Index (in texels, half the word index) of each level's first texel, level 0 first.
     pub(super) offsets: Vec<u32>,
+    /// The offsets as a [`LaneTable`].
+    pub(super) lane_offsets: LaneTable,
 }
 
 impl Linear15Copy {
@@ -130,7 +156,12 @@ impl Linear15Copy {
             }
         }
         debug_assert_eq!(words.len(), 2 * padded);
-        Self { words, offsets }
+        let lane_offsets = lane_table(&offsets);
+        Self {
+            words,
+            offsets,
+            lane_offsets,
+        }
     }
 }
 
@@ -212,6 +243,8 @@ impl Texture {
             offset += w as usize * h as usize;
         }
         debug_assert_eq!(texels.len(), total);
+        levels.lane_offsets = lane_table(&levels.offsets);
+        levels.lane_sizes = [lane_table(&levels.widths), lane_table(&levels.heights)];
         Self {
             texels,
             levels,
