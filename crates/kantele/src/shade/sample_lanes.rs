@@ -6,7 +6,8 @@
 //! lane, every wrap mode and every filter. Texels are read through a [`TexelSource`]
 //! ([`texel_lanes`](super::texel_lanes)): one per lane, or, where the two columns of every
 //! lane's bilinear footprint are neighbours in memory, one row's two texels at once (each lane's
-//! level offset and size gathered from the level table when the lanes' levels differ).
+//! level offset and size looked up in 16-entry tables by two permutes, whatever mix of levels
+//! a row holds).
 //!
 //! Filtering is fixed point: texels in units of 1/32640 ([`LINEAR15_SCALE`]; a linear byte `k`
 //! is `k · 128`, an sRGB byte its exact linear value rounded to that unit,
