@@ -209,7 +209,7 @@ fn kantele_isa_is_checked() {
     let out = dir.s("cube.png");
     let args = ["render", "--builtin", "cube", "--size", "64x48", "-o", &out];
     // A value that names no level: one clean line, nothing written.
-    let o = kantele_with_env(&args, "KANTELE_ISA", "mmx");
+    let o = kantele_with_env(&args, &[("KANTELE_ISA", "mmx")]);
     assert_clean_failure(&o, "KANTELE_ISA: unknown instruction set `mmx`", &dir, &[]);
     // A level this CPU lacks: a warning, and the picture from the best level.
     let missing = if cfg!(target_arch = "aarch64") {
@@ -217,14 +217,14 @@ fn kantele_isa_is_checked() {
     } else {
         "neon"
     };
-    let o = kantele_with_env(&args, "KANTELE_ISA", missing);
+    let o = kantele_with_env(&args, &[("KANTELE_ISA", missing)]);
     ok(&o);
     let warning = format!("kantele: warning: KANTELE_ISA={missing}: this CPU does not support it");
     assert!(stderr(&o).contains(&warning), "{}", stderr(&o));
     assert!(dir.path("cube.png").is_file());
     // A supported level, and an empty value (no override): no warning.
     for value in ["scalar", ""] {
-        let o = kantele_with_env(&args, "KANTELE_ISA", value);
+        let o = kantele_with_env(&args, &[("KANTELE_ISA", value)]);
         ok(&o);
         assert!(!stderr(&o).contains("KANTELE_ISA"), "{}", stderr(&o));
     }

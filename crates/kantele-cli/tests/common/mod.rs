@@ -45,14 +45,14 @@ impl Drop for TempDir {
 
 /// Runs the binary with `args`.
 pub fn kantele(args: &[&str]) -> Output {
-    Command::new(BIN).args(args).output().expect("run kantele")
+    kantele_with_env(args, &[])
 }
 
-/// Runs the binary with `args` and the environment variable `name` set to `value`.
-pub fn kantele_with_env(args: &[&str], name: &str, value: &str) -> Output {
+/// Runs the binary with `args` and the environment variables `env` (name, value) set.
+pub fn kantele_with_env(args: &[&str], env: &[(&str, &str)]) -> Output {
     Command::new(BIN)
         .args(args)
-        .env(name, value)
+        .envs(env.iter().copied())
         .output()
         .expect("run kantele")
 }

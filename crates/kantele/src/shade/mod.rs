@@ -1,4 +1,5 @@
 //! Shading resources: textures, their 8-bit texel format and the samplers that read them.
+mod levels;
 pub(crate) mod sample_lanes;
 pub mod texel;
 mod texel_lanes;

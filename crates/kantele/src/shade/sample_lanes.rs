@@ -26,11 +26,10 @@ use crate::simd::{
     bilinear15, lerp15_channels, F32x8, Footprint15, I32x8, Lanes, Mask8, MaskOf, TexelGather,
 };
 
+use super::levels::LaneTable;
 use super::texel::{linear15_table, LINEAR15_SCALE};
 use super::texel_lanes::{Channels, TexelSource};
-use super::texture::{
-    ColorSpace, Filter, LaneTable, Linear15Copy, MinFilter, Sampler, Texture, Wrap,
-};
+use super::texture::{ColorSpace, Filter, Linear15Copy, MinFilter, Sampler, Texture, Wrap};
 
 impl Texture {
     /// Samples eight texture coordinates at once, each with the level of detail from its own

@@ -23,6 +23,7 @@ use std::sync::OnceLock;
 
 use glam::{Vec2, Vec4};
 
+use super::levels::{lane_table, LaneTable, LevelTable};
 use super::texel::{
     decode_table, decode_texel, encode_texel, pack_rgba8, srgb_texel_to_linear15, unpack_rgba8,
 };
@@ -71,42 +72,6 @@ impl MipLevel<'_> {
     pub fn packed(&self, x: u32, y: u32) -> u32 {
         self.texels[y as usize * self.width as usize + x as usize]
     }
-}
-
-/// Where each mip level lies in the texel storage, one entry per level (level 0 first), and
-/// the same as [`LaneTable`]s for the lane-wide sampler.
-#[derive(Clone, Debug, Default)]
-pub(super) struct LevelTable {
-    /// Index of each level's first texel.
-    pub(super) offsets: Vec<u32>,
-    /// Width of each level in texels.
-    pub(super) widths: Vec<u32>,
-    /// Height of each level in texels.
-    pub(super) heights: Vec<u32>,
-    /// The offsets as a [`LaneTable`].
-    pub(super) lane_offsets: LaneTable,
-    /// The widths and heights as [`LaneTable`]s.
-    pub(super) lane_sizes: [LaneTable; 2],
-}
-
-/// The per-level values of a mip chain (at most 16 levels: [`MAX_TEXTURE_SIZE`] has 15) in the
-/// form the lane-wide sampler looks them up, two 8-lane permutes: the values of levels
-/// `0..16`, the last level's repeated past the last level.
-pub(super) type LaneTable = [i32; 16];
-
-const _: () = assert!(
-    MAX_TEXTURE_SIZE.ilog2() < 16,
-    "a mip chain must fit a LaneTable"
-);
-
-/// `values` (one per level, at most 16, each below 2³¹: offsets of at most 16384² · 4/3
-/// texels, sizes of at most 16384) as a [`LaneTable`].
-pub(super) fn lane_table(values: &[u32]) -> LaneTable {
-    let last = values.last().copied().unwrap_or(0);
-    std::array::from_fn(|k| {
-        let value = values.get(k).copied().unwrap_or(last);
-        i32::try_from(value).unwrap_or(i32::MAX)
-    })
 }
 
 /// A 2D texture with its complete mip chain, stored as packed RGBA8.
@@ -226,25 +191,14 @@ impl Texture {
             sizes.push(((w / 2).max(1), (h / 2).max(1)));
         }
         let total: usize = sizes.iter().map(|&(w, h)| w as usize * h as usize).sum();
+        let levels = LevelTable::new(&sizes);
         let mut texels = level0;
         texels.reserve_exact(total - texels.len());
-        let mut levels = LevelTable::default();
-        let mut offset = 0usize;
-        for (i, &(w, h)) in sizes.iter().enumerate() {
-            if i > 0 {
-                let (pw, ph) = sizes[i - 1];
-                let previous = offset - pw as usize * ph as usize;
-                downsample(&mut texels, previous, (pw, ph), color_space);
-            }
-            // At most 16384² × 4/3 texels: fits in u32 (and i32, for the gathers).
-            levels.offsets.push(offset as u32);
-            levels.widths.push(w);
-            levels.heights.push(h);
-            offset += w as usize * h as usize;
+        // Each level from the one before it, the last one excepted.
+        for (&previous, &size) in levels.offsets.iter().zip(&sizes).take(sizes.len() - 1) {
+            downsample(&mut texels, previous as usize, size, color_space);
         }
         debug_assert_eq!(texels.len(), total);
-        levels.lane_offsets = lane_table(&levels.offsets);
-        levels.lane_sizes = [lane_table(&levels.widths), lane_table(&levels.heights)];
         Self {
             texels,
             levels,

@@ -1,0 +1,61 @@
+//! Where each level of a texture's mip chain lies: a [`LevelTable`] of offsets and sizes, and
+//! the same values as [`LaneTable`]s, the form the lane-wide sampler looks them up in.
+
+use super::texture::MAX_TEXTURE_SIZE;
+
+/// Where each mip level lies in the texel storage, one entry per level (level 0 first), and
+/// the same as [`LaneTable`]s for the lane-wide sampler.
+#[derive(Clone, Debug)]
+pub(super) struct LevelTable {
+    /// Index of each level's first texel.
+    pub(super) offsets: Vec<u32>,
+    /// Width of each level in texels.
+    pub(super) widths: Vec<u32>,
+    /// Height of each level in texels.
+    pub(super) heights: Vec<u32>,
+    /// The offsets as a [`LaneTable`].
+    pub(super) lane_offsets: LaneTable,
+    /// The widths and heights as [`LaneTable`]s.
+    pub(super) lane_sizes: [LaneTable; 2],
+}
+
+impl LevelTable {
+    /// The table of a chain whose levels, stored one after another, have `sizes` (width,
+    /// height), level 0 first (at most 16 levels, at most 16384² · 4/3 texels in all).
+    pub(super) fn new(sizes: &[(u32, u32)]) -> Self {
+        let mut offsets = Vec::with_capacity(sizes.len());
+        let mut offset = 0u32;
+        for &(w, h) in sizes {
+            offsets.push(offset);
+            offset += w * h;
+        }
+        let (widths, heights): (Vec<u32>, Vec<u32>) = sizes.iter().copied().unzip();
+        Self {
+            lane_offsets: lane_table(&offsets),
+            lane_sizes: [lane_table(&widths), lane_table(&heights)],
+            offsets,
+            widths,
+            heights,
+        }
+    }
+}
+
+/// The per-level values of a mip chain (at most 16 levels: [`MAX_TEXTURE_SIZE`] has 15) in the
+/// form the lane-wide sampler looks them up, two 8-lane permutes: the values of levels
+/// `0..16`, the last level's repeated past the last level.
+pub(super) type LaneTable = [i32; 16];
+
+const _: () = assert!(
+    MAX_TEXTURE_SIZE.ilog2() < 16,
+    "a mip chain must fit a LaneTable"
+);
+
+/// `values` (one per level, at most 16, each below 2³¹: offsets of at most 16384² · 4/3
+/// texels, sizes of at most 16384) as a [`LaneTable`].
+pub(super) fn lane_table(values: &[u32]) -> LaneTable {
+    let last = values.last().copied().unwrap_or(0);
+    std::array::from_fn(|k| {
+        let value = values.get(k).copied().unwrap_or(last);
+        i32::try_from(value).unwrap_or(i32::MAX)
+    })
+}
