@@ -24,9 +24,9 @@ Id names follow glTF and are the CLI's ``--ids KIND=FILE`` kinds: a *primitive* 
 primitive placed by a node (one draw), a *triangle* is a triangle's index within it.
 """
 
-from ._kantele import MAX_SIZE, OUTPUTS, Camera, Scene, load, write_png
+from ._kantele import MAX_SIZE, OUTPUTS, Camera, Scene, isa, load, write_png
 
 #: The names of the ``ids`` output's channels, in order (the CLI's ``--ids`` kinds).
 ID_CHANNELS = ("instance", "triangle", "primitive")
 
-__all__ = ["Camera", "Scene", "load", "write_png", "MAX_SIZE", "OUTPUTS", "ID_CHANNELS"]
+__all__ = ["Camera", "Scene", "load", "write_png", "isa", "MAX_SIZE", "OUTPUTS", "ID_CHANNELS"]

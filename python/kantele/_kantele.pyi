@@ -22,6 +22,12 @@ def load(path: PathLike) -> Scene:
 def write_png(path: PathLike, image: npt.NDArray[np.uint8]) -> None:
     """Writes a `uint8` (H, W, 4) or (H, W, 3) image, row 0 at the top, as PNG."""
 
+def isa() -> str:
+    """The instruction set the CPU renderer uses in this process (`avx512`, `avx2`, `sse41`,
+    `sse2`, `neon` or `scalar`): the best this CPU has, or the one `KANTELE_ISA` names. A
+    `KANTELE_ISA` naming no level, or one this CPU lacks, gives a `RuntimeWarning` at import and
+    the best level."""
+
 class Camera:
     """A camera (conventions of `kantele_io::pose`, as the CLI's sidecar): the OpenGL camera
     frame looks down -Z with y up, the OpenCV frame down +Z with y down; intrinsics in pixels

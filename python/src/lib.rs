@@ -12,6 +12,10 @@ mod scene;
 
 use std::path::PathBuf;
 
+use std::ffi::CString;
+
+use kantele::simd::Isa;
+use pyo3::exceptions::PyRuntimeWarning;
 use pyo3::prelude::*;
 
 use camera::PyCamera;
@@ -23,6 +27,31 @@ fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
     PyScene::load_path(py, path)
 }
 
+/// The instruction set the CPU renderer uses in this process (`avx512`, `avx2`, `sse41`,
+/// `sse2`, `neon` or `scalar`): the best one this CPU has, or the one `KANTELE_ISA` names.
+#[pyfunction]
+fn isa() -> &'static str {
+    Isa::selected().name()
+}
+
+/// Warns (`RuntimeWarning`, once, at import) when `KANTELE_ISA` names no instruction set or one
+/// this CPU lacks; renders then use the best level, as the `kantele` command does.
+fn warn_about_isa_env(py: Python<'_>) -> PyResult<()> {
+    let best = Isa::best();
+    let message = match Isa::from_env() {
+        // The message names the variable already.
+        Err(problem) => format!("{problem}; using {best}"),
+        Ok(Some(forced)) if !forced.is_supported() => {
+            format!("KANTELE_ISA={forced}: this CPU does not support it; using {best}")
+        }
+        Ok(_) => return Ok(()),
+    };
+    // An environment variable holds no NUL byte, so neither does the message.
+    let message = CString::new(message).unwrap_or_default();
+    let category = py.get_type::<PyRuntimeWarning>();
+    PyErr::warn(py, category.as_any(), &message, 1)
+}
+
 /// The extension module.
 #[pymodule]
 fn _kantele(m: &Bound<'_, PyModule>) -> PyResult<()> {
@@ -30,6 +59,7 @@ fn _kantele(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<PyCamera>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(files::write_png, m)?)?;
+    m.add_function(wrap_pyfunction!(isa, m)?)?;
     m.add("MAX_SIZE", kantele::MAX_TARGET_SIZE)?;
     m.add(
         "OUTPUTS",
@@ -38,5 +68,5 @@ fn _kantele(m: &Bound<'_, PyModule>) -> PyResult<()> {
             .map(|(n, _)| *n)
             .collect::<Vec<_>>(),
     )?;
-    Ok(())
+    warn_about_isa_env(m.py())
 }
