@@ -312,7 +312,10 @@ pub const SMALL_BOX_PIXELS: i64 = 4;
 
 /// Sets up one triangle from its window-space vertices ([`Viewport::window_vertex`] of positions
 /// with `w > 0` inside the guard band): the same record as [`setup_triangle`].
-#[inline]
+///
+/// Always inlined: the primitive stage calls it once per triangle, and as a call it returned
+/// the record (over 200 bytes) through memory, to be copied again into the batch.
+#[inline(always)]
 pub fn setup_window_triangle(
     viewport: &Viewport,
     window: [WindowVertex; 3],
