@@ -296,18 +296,28 @@ pub fn dispatch<K: LaneKernel>(isa: Isa, kernel: K) -> K::Output {
         #[cfg(target_arch = "x86_64")]
         Isa::Sse2 => {
             if let Some(token) = Sse2::new() {
-                return kernel.run(token);
+                return run_out_of_line(token, kernel);
             }
         }
         #[cfg(target_arch = "aarch64")]
         Isa::Neon => {
             if let Some(token) = Neon::new() {
-                return kernel.run(token);
+                return run_out_of_line(token, kernel);
             }
         }
         _ => {}
     }
-    kernel.run(Scalar)
+    run_out_of_line(Scalar, kernel)
+}
+
+/// Runs `kernel` with `lanes` in a function of its own, as the `#[target_feature]` entry
+/// points of the other levels do. Inlined into [`dispatch`] instead, the scalar and SSE2
+/// kernels made every `dispatch` a function of several kilobytes with a frame of up to 16 KiB
+/// (probed page by page on each call), paid on each call whatever the level; `dispatch` is
+/// now a few instructions and inlined into its callers.
+#[inline(never)]
+fn run_out_of_line<L: Lanes, K: LaneKernel>(lanes: L, kernel: K) -> K::Output {
+    kernel.run(lanes)
 }
 
 /// The mask type of a lane value's implementation.
