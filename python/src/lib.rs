@@ -10,9 +10,8 @@ mod mesh_arrays;
 mod render;
 mod scene;
 
-use std::path::PathBuf;
-
 use std::ffi::CString;
+use std::path::PathBuf;
 
 use kantele::simd::Isa;
 use pyo3::exceptions::PyRuntimeWarning;

@@ -313,8 +313,8 @@ pub fn dispatch<K: LaneKernel>(isa: Isa, kernel: K) -> K::Output {
 /// Runs `kernel` with `lanes` in a function of its own, as the `#[target_feature]` entry
 /// points of the other levels do. Inlined into [`dispatch`] instead, the scalar and SSE2
 /// kernels made every `dispatch` a function of several kilobytes with a frame of up to 16 KiB
-/// (probed page by page on each call), paid on each call whatever the level; `dispatch` is
-/// now a few instructions and inlined into its callers.
+/// (probed page by page), paid on each call whatever the level. Now `dispatch` is a few
+/// instructions, and a third of its instances are inlined into their callers.
 #[inline(never)]
 fn run_out_of_line<L: Lanes, K: LaneKernel>(lanes: L, kernel: K) -> K::Output {
     kernel.run(lanes)
