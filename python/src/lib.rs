@@ -36,14 +36,11 @@ fn isa() -> &'static str {
 /// Warns (`RuntimeWarning`, once, at import) when `KANTELE_ISA` names no instruction set or one
 /// this CPU lacks; renders then use the best level, as the `kantele` command does.
 fn warn_about_isa_env(py: Python<'_>) -> PyResult<()> {
-    let best = Isa::best();
-    let message = match Isa::from_env() {
+    let message = match Isa::env_warning() {
         // The message names the variable already.
-        Err(problem) => format!("{problem}; using {best}"),
-        Ok(Some(forced)) if !forced.is_supported() => {
-            format!("KANTELE_ISA={forced}: this CPU does not support it; using {best}")
-        }
-        Ok(_) => return Ok(()),
+        Err(problem) => format!("{problem}; using {}", Isa::best()),
+        Ok(Some(warning)) => warning,
+        Ok(None) => return Ok(()),
     };
     // An environment variable holds no NUL byte, so neither does the message.
     let message = CString::new(message).unwrap_or_default();

@@ -94,14 +94,8 @@ fn usage_error_line(text: &str) -> String {
 /// instruction-set level is an error; a level this CPU lacks gets a warning, and the renderer
 /// uses its best level instead (the `isa` column of `bench` says which).
 fn check_isa_env() -> Result<(), String> {
-    use kantele::simd::Isa;
-    if let Some(forced) = Isa::from_env()? {
-        if !forced.is_supported() {
-            eprintln!(
-                "kantele: warning: KANTELE_ISA={forced}: this CPU does not support it; using {}",
-                Isa::best()
-            );
-        }
+    if let Some(warning) = kantele::simd::Isa::env_warning()? {
+        eprintln!("kantele: warning: {warning}");
     }
     Ok(())
 }

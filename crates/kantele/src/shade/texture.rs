@@ -112,7 +112,7 @@ impl Linear15Copy {
         let mut words = Vec::with_capacity(2 * padded);
         let mut offsets = Vec::with_capacity(texture.level_count());
         for level in texture.levels() {
-            // At most (16384 + 1) · 16384 · 4/3 texels: fits in u32 (and i32, for the gathers).
+            // At most (16384 + 1) · 16384 · 4/3 texels: fits u32 (and i32, for the lane table).
             offsets.push((words.len() / 2) as u32);
             for row in level.texels.chunks_exact(level.width as usize) {
                 for &texel in row.iter().chain(&row[..1]) {

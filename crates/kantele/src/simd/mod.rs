@@ -204,6 +204,21 @@ impl Isa {
         }
     }
 
+    /// What a front end tells its user about `KANTELE_ISA`, which the renderer reads without
+    /// complaint ([`Isa::selected`]): an error (one line, naming the variable) when it names
+    /// no level; `Ok(Some(warning))` when it names a level this CPU lacks, which renders
+    /// replace by [`Isa::best`]; `Ok(None)` when it is unset, empty or supported.
+    pub fn env_warning() -> Result<Option<String>, String> {
+        Ok(Isa::from_env()?
+            .filter(|forced| !forced.is_supported())
+            .map(|forced| {
+                format!(
+                    "{ISA_ENV}={forced}: this CPU does not support it; using {}",
+                    Isa::best()
+                )
+            }))
+    }
+
     /// The level this process uses, decided once and cached: the `KANTELE_ISA` level when it
     /// is set, valid and supported by this CPU, otherwise [`Isa::best`]. (An invalid or
     /// unsupported `KANTELE_ISA` is ignored here; front ends report it with [`Isa::from_env`].)
