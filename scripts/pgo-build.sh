@@ -46,29 +46,30 @@ scenes=(--builtin cube --builtin teapot --builtin ground --builtin pixel-edges
 levels=()
 for isa in scalar sse2 sse41 avx2 avx512 neon; do
     # (A level the CPU lacks also prints a warning, expected here: not shown.)
-    used=$(KANTELE_ISA=$isa "$kantele" bench --builtin pixel-edges --frames 1 --warmup 0 --json \
+    used=$(KANTELE_ISA=$isa "$kantele" bench --builtin pixel-edges --frames 1 --warmup 0 --warmup-ms 0 --json \
         2>/dev/null)
     if [[ $used == *"\"isa\":\"$isa\""* ]]; then
         levels+=("$isa")
     fi
 done
+# (`--warmup-ms 0` throughout: training needs the paths' counts, not steady frame times.)
 for isa in "${levels[@]}"; do
     # The scalar level is the readable reference, slow when instrumented: fewer frames.
     frames=10
     [[ $isa == scalar ]] && frames=2
     for threads in 1 2; do
-        KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames "$frames" --warmup 1 \
+        KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames "$frames" --warmup 1 --warmup-ms 0 \
             --threads "$threads" >/dev/null
     done
-    KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames 3 --warmup 1 --msaa 4 >/dev/null
-    KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames 3 --warmup 1 --target srgb8 \
+    KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames 3 --warmup 1 --warmup-ms 0 --msaa 4 >/dev/null
+    KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames 3 --warmup 1 --warmup-ms 0 --target srgb8 \
         >/dev/null
 done
 # Small triangles (a far teapot) and full-screen fill (a close cube), beside the scenes' own sizes.
-"$kantele" bench --builtin teapot --size 160x120 --frames 20 --warmup 1 >/dev/null
-"$kantele" bench --builtin cube --size 2048x1536 --frames 3 --warmup 1 >/dev/null
+"$kantele" bench --builtin teapot --size 160x120 --frames 20 --warmup 1 --warmup-ms 0 >/dev/null
+"$kantele" bench --builtin cube --size 2048x1536 --frames 3 --warmup 1 --warmup-ms 0 >/dev/null
 for strategy in bbox incremental block adaptive; do
-    "$kantele" bench "${scenes[@]}" --frames 3 --warmup 1 --strategy "$strategy" >/dev/null
+    "$kantele" bench "${scenes[@]}" --frames 3 --warmup 1 --warmup-ms 0 --strategy "$strategy" >/dev/null
 done
 "$kantele" render --builtin teapot -o "$out/training-teapot.png"
 "$profdata" merge -o "$out/kantele.profdata" "$out/raw"

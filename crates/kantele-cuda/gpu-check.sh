@@ -17,7 +17,9 @@
 #  3. ten repeated cuda renders of three scenes: byte-identical PNGs and depth files;
 #  4. compute-sanitizer memcheck and racecheck on one render (it refuses the GPU on some
 #     machines: that is logged, not hidden);
-#  5. `kantele bench` of every scene with cpu, cuda, cuda-ocot, cuda-ocmt and gl.
+#  5. `kantele bench` of every scene with cpu, cuda, cuda-ocot, cuda-ocmt and gl;
+#  6. the CPU backend's thread scaling (issue 7): every scene at 1, 2, 4, 8 and 16 threads
+#     (`--json`, one file per count: scaling-N.json), with the 16 / 1 ratios in scaling.log.
 # The script goes on after a failing step and exits non-zero if any step failed.
 set -uo pipefail
 here="$(cd "$(dirname "$0")/../.." && pwd)"
@@ -138,6 +140,28 @@ run() {
 
   step bench "$k" bench "${all[@]}" --backends cpu,cuda,cuda-ocot,cuda-ocmt,gl --frames 10 --warmup 3
   cat "$out/bench.log" >>"$summary"
+
+  scaling() {
+    local t
+    for t in 1 2 4 8 16; do
+      "$k" bench "${all[@]}" --threads "$t" --frames 20 --json >"$out/scaling-$t.json" || return 1
+    done
+    python3 - "$out" <<'PY'
+import json, math, sys
+out = sys.argv[1]
+ms = {t: {j["scene"]: j["median_ms"] for j in map(json.loads, open(f"{out}/scaling-{t}.json"))}
+      for t in (1, 2, 4, 8, 16)}
+ratios = []
+print(f"{'scene':28} " + " ".join(f"{t:>8}" for t in ms) + "    16/1")
+for s in ms[1]:
+    r = ms[1][s] / ms[16][s]
+    ratios.append(r)
+    print(f"{s:28} " + " ".join(f"{ms[t][s]:8.3f}" for t in ms) + f" {r:7.2f}")
+print(f"{'geometric mean':28} " + " " * 45 + f" {math.exp(sum(map(math.log, ratios)) / len(ratios)):7.2f}")
+PY
+  }
+  step scaling scaling
+  cat "$out/scaling.log" >>"$summary"
   echo "logs in $out"
   return $failed
 }

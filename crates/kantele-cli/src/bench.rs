@@ -2,7 +2,7 @@
 //! scenes (warm-up, then N timed `render()` calls; median, min, max).
 
 use std::sync::Arc;
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Result};
 use kantele::backend::{Backend, FrameView};
@@ -106,15 +106,37 @@ struct Row {
     ratio: Option<f64>,
 }
 
+/// The untimed warm-up of one scene on one backend: at least `frames` frames and at least `time`.
+#[derive(Clone, Copy, Debug)]
+struct Warmup {
+    frames: u32,
+    time: Duration,
+}
+
+impl Warmup {
+    /// Calls `render` until both this many frames and this long have passed; returns how many
+    /// frames that took, or the first error.
+    fn run<E>(&self, mut render: impl FnMut() -> Result<(), E>) -> Result<u64, E> {
+        let start = Instant::now();
+        let mut done = 0u64;
+        while done < u64::from(self.frames) || start.elapsed() < self.time {
+            render()?;
+            done += 1;
+        }
+        Ok(done)
+    }
+}
+
+/// Warms `backend` up on `view`, then times `frames` frames; also returns the warm-up frames.
 fn time_frames(
     backend: &mut dyn Backend,
     view: &FrameView,
-    warmup: u32,
+    warmup: Warmup,
     frames: u32,
-) -> Result<FrameTimes, String> {
-    for _ in 0..warmup {
-        backend.render(view).map_err(|e| e.to_string())?;
-    }
+) -> Result<(FrameTimes, u64), String> {
+    let warmup_frames = warmup
+        .run(|| backend.render(view).map(drop))
+        .map_err(|e| e.to_string())?;
     let mut times = Vec::with_capacity(frames as usize);
     let mut stages = Vec::with_capacity(frames as usize);
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1000.0;
@@ -129,10 +151,11 @@ fn time_frames(
         ]);
     }
     let frames = summarize(&times).ok_or_else(|| "no frames timed".to_string())?;
-    Ok(FrameTimes {
+    let times = FrameTimes {
         frames,
         stages: StageTimes::median_of(&stages),
-    })
+    };
+    Ok((times, warmup_frames))
 }
 
 fn print_table(rows: &[Row], ratios: bool) {
@@ -278,6 +301,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
         }
     }
 
+    let warmup = Warmup {
+        frames: args.warmup,
+        time: Duration::from_millis(args.warmup_ms),
+    };
     let mut warnings = Warnings::default();
     let mut rows = Vec::new();
     for input in &inputs {
@@ -297,10 +324,14 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                     let result = b
                         .load(scene.clone())
                         .map_err(|e| e.to_string())
-                        .and_then(|()| time_frames(b.as_mut(), &view, args.warmup, args.frames));
+                        .and_then(|()| time_frames(b.as_mut(), &view, warmup, args.frames));
                     (b.renderer(), b.threads(), b.isa(), result)
                 }
                 Err(e) => ("-".to_string(), 0, "-".to_string(), Err(e.clone())),
+            };
+            let (result, warmup_frames) = match result {
+                Ok((times, warmup_frames)) => (Ok(times), Some(warmup_frames)),
+                Err(e) => (Err(e), None),
             };
             if let Err(e) = &result {
                 if !several {
@@ -346,7 +377,8 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                         "width": row.width, "height": row.height,
                         "triangles": row.triangles, "draws": row.draws,
                         "backend": row.backend, "renderer": row.renderer, "threads": row.threads, "isa": row.isa, "target": row.target, "msaa": row.msaa,
-                        "frames": args.frames, "warmup": args.warmup,
+                        "frames": args.frames, "warmup": args.warmup, "warmup_ms": args.warmup_ms,
+                        "warmup_frames": warmup_frames,
                         // How this binary was compiled (build.rs): figures name their build.
                         "build": env!("KANTELE_BUILD"),
                         "median_ms": median, "min_ms": min, "max_ms": max,
@@ -402,6 +434,49 @@ mod tests {
                 raster: 8.0
             })
         );
+    }
+
+    #[test]
+    fn warm_up_lasts_for_both_its_frames_and_its_time() {
+        let count = |warmup: Warmup, frame: Duration| {
+            warmup.run(|| {
+                std::thread::sleep(frame);
+                Ok::<(), ()>(())
+            })
+        };
+        let frames_only = Warmup {
+            frames: 3,
+            time: Duration::ZERO,
+        };
+        assert_eq!(count(frames_only, Duration::ZERO), Ok(3));
+        // 40 ms of 1 ms frames: at least one frame per elapsed millisecond is impossible to
+        // exceed, so the count is at most 40 and more than the 3 frames asked for.
+        let timed = Warmup {
+            frames: 3,
+            time: Duration::from_millis(40),
+        };
+        let start = Instant::now();
+        let n = count(timed, Duration::from_millis(1)).unwrap();
+        assert!(start.elapsed() >= Duration::from_millis(40));
+        assert!((4..=40).contains(&n), "{n} frames");
+        // Slow frames: the frame count still holds.
+        let slow = Warmup {
+            frames: 2,
+            time: Duration::from_millis(1),
+        };
+        assert_eq!(count(slow, Duration::from_millis(5)), Ok(2));
+        // No warm-up at all, and the first error ends it.
+        let none = Warmup {
+            frames: 0,
+            time: Duration::ZERO,
+        };
+        assert_eq!(count(none, Duration::ZERO), Ok(0));
+        let mut calls = 0;
+        let failing = timed.run(|| {
+            calls += 1;
+            Err::<(), _>("lost")
+        });
+        assert_eq!((failing, calls), (Err("lost"), 1));
     }
 
     #[test]

@@ -432,6 +432,12 @@ pub struct BenchArgs {
     /// Untimed warm-up frames before them.
     #[arg(long, default_value_t = 3)]
     pub warmup: u32,
+    /// Untimed warm-up time per scene and backend, in milliseconds: warm-up frames go on until
+    /// both `--warmup` frames and this long have passed. The first frames of a busy spell can
+    /// run slower than the rest (cold caches, worker threads waking, virtual CPUs the host has
+    /// not yet spread over its cores), and a short scene's frames would all fall in it.
+    #[arg(long, default_value_t = 300, value_name = "MS")]
+    pub warmup_ms: u64,
     /// Image size WxH instead of the scene's resolution.
     #[arg(long, value_name = "WxH", value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
