@@ -494,15 +494,28 @@ mod tests {
             state ^= state << 17;
             state
         };
-        for case in 0..20_000 {
+        for case in 0..60_000 {
             let n = 1 + (next() % 64) as i32;
             // Small steps cross within the row; large ones (up to 2^40) test the division at
-            // the scale of big triangles' edge values.
+            // the scale of big triangles' edge values. One case in 16 has an edge parallel to
+            // the rows; one in three crosses exactly at a pixel centre (value 0 there).
             let scale = if case % 2 == 0 { 1 << 10 } else { 1i64 << 40 };
-            let step_x: [i64; 3] = std::array::from_fn(|_| (next() as i64) % scale);
+            let step_x: [i64; 3] = std::array::from_fn(|e| match (case % 16, e) {
+                (5, 1) => 0,
+                _ => (next() as i64) % scale,
+            });
+            let exact = case % 3 == 0;
             let row: [i64; 3] = std::array::from_fn(|e| {
                 let crossing = (next() % (n as u64 + 2)) as i64 - 1;
-                -step_x[e] * crossing + (next() as i64) % (step_x[e].abs() + 1)
+                let offset = if exact {
+                    0
+                } else {
+                    (next() as i64) % (step_x[e].abs() + 1)
+                };
+                match step_x[e] {
+                    0 => (next() as i64) % 3 - 1,
+                    s => -s * crossing + offset,
+                }
             });
             let stepper = EdgeStepper {
                 value: row,
