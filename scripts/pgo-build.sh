@@ -43,6 +43,8 @@ scenes=(--builtin cube --builtin teapot --builtin ground --builtin pixel-edges
     "$out/training-cubes.obj")
 # The instruction-set levels this CPU has, as the renderer itself decides (`Isa::supported`):
 # it replaces a level the CPU lacks by its best one, and `bench --json` names the level used.
+# One warm-up frame and no timed warm-up: training needs the paths' counts, not steady times.
+quick=(--warmup 1 --warmup-ms 0)
 levels=()
 for isa in scalar sse2 sse41 avx2 avx512 neon; do
     # (A level the CPU lacks also prints a warning, expected here: not shown.)
@@ -52,24 +54,23 @@ for isa in scalar sse2 sse41 avx2 avx512 neon; do
         levels+=("$isa")
     fi
 done
-# (`--warmup-ms 0` throughout: training needs the paths' counts, not steady frame times.)
 for isa in "${levels[@]}"; do
     # The scalar level is the readable reference, slow when instrumented: fewer frames.
     frames=10
     [[ $isa == scalar ]] && frames=2
     for threads in 1 2; do
-        KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames "$frames" --warmup 1 --warmup-ms 0 \
+        KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames "$frames" "${quick[@]}" \
             --threads "$threads" >/dev/null
     done
-    KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames 3 --warmup 1 --warmup-ms 0 --msaa 4 >/dev/null
-    KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames 3 --warmup 1 --warmup-ms 0 --target srgb8 \
+    KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames 3 "${quick[@]}" --msaa 4 >/dev/null
+    KANTELE_ISA=$isa "$kantele" bench "${scenes[@]}" --frames 3 "${quick[@]}" --target srgb8 \
         >/dev/null
 done
 # Small triangles (a far teapot) and full-screen fill (a close cube), beside the scenes' own sizes.
-"$kantele" bench --builtin teapot --size 160x120 --frames 20 --warmup 1 --warmup-ms 0 >/dev/null
-"$kantele" bench --builtin cube --size 2048x1536 --frames 3 --warmup 1 --warmup-ms 0 >/dev/null
+"$kantele" bench --builtin teapot --size 160x120 --frames 20 "${quick[@]}" >/dev/null
+"$kantele" bench --builtin cube --size 2048x1536 --frames 3 "${quick[@]}" >/dev/null
 for strategy in bbox incremental block adaptive; do
-    "$kantele" bench "${scenes[@]}" --frames 3 --warmup 1 --warmup-ms 0 --strategy "$strategy" >/dev/null
+    "$kantele" bench "${scenes[@]}" --frames 3 "${quick[@]}" --strategy "$strategy" >/dev/null
 done
 "$kantele" render --builtin teapot -o "$out/training-teapot.png"
 "$profdata" merge -o "$out/kantele.profdata" "$out/raw"

@@ -142,22 +142,23 @@ run() {
   cat "$out/bench.log" >>"$summary"
 
   scaling() {
-    local t
-    for t in 1 2 4 8 16; do
+    local t threads=(1 2 4 8 16)
+    for t in "${threads[@]}"; do
       "$k" bench "${all[@]}" --threads "$t" --frames 20 --json >"$out/scaling-$t.json" || return 1
     done
-    python3 - "$out" <<'PY'
+    python3 - "$out" "${threads[@]}" <<'PY'
 import json, math, sys
-out = sys.argv[1]
+out, threads = sys.argv[1], sys.argv[2:]
 ms = {t: {j["scene"]: j["median_ms"] for j in map(json.loads, open(f"{out}/scaling-{t}.json"))}
-      for t in (1, 2, 4, 8, 16)}
+      for t in threads}
+first, last = threads[0], threads[-1]
 ratios = []
-print(f"{'scene':28} " + " ".join(f"{t:>8}" for t in ms) + "    16/1")
-for s in ms[1]:
-    r = ms[1][s] / ms[16][s]
+print(f"{'scene':28} " + " ".join(f"{t:>8}" for t in ms) + f"    {last}/{first}")
+for s in ms[first]:
+    r = ms[first][s] / ms[last][s]
     ratios.append(r)
     print(f"{s:28} " + " ".join(f"{ms[t][s]:8.3f}" for t in ms) + f" {r:7.2f}")
-print(f"{'geometric mean':28} " + " " * 45 + f" {math.exp(sum(map(math.log, ratios)) / len(ratios)):7.2f}")
+print(f"{'geometric mean':28} " + " " * (9 * len(ms)) + f" {math.exp(sum(map(math.log, ratios)) / len(ratios)):7.2f}")
 PY
   }
   step scaling scaling

@@ -63,6 +63,8 @@ pub struct FrameTimes {
     pub frames: Timing,
     /// Median stage times.
     pub stages: Option<StageTimes>,
+    /// Untimed warm-up frames rendered before them.
+    pub warmup_frames: u64,
 }
 
 /// Median, min and max of frame times; `None` for no frames.
@@ -127,13 +129,13 @@ impl Warmup {
     }
 }
 
-/// Warms `backend` up on `view`, then times `frames` frames; also returns the warm-up frames.
+/// Warms `backend` up on `view`, then times `frames` frames.
 fn time_frames(
     backend: &mut dyn Backend,
     view: &FrameView,
     warmup: Warmup,
     frames: u32,
-) -> Result<(FrameTimes, u64), String> {
+) -> Result<FrameTimes, String> {
     let warmup_frames = warmup
         .run(|| backend.render(view).map(drop))
         .map_err(|e| e.to_string())?;
@@ -151,11 +153,11 @@ fn time_frames(
         ]);
     }
     let frames = summarize(&times).ok_or_else(|| "no frames timed".to_string())?;
-    let times = FrameTimes {
+    Ok(FrameTimes {
         frames,
         stages: StageTimes::median_of(&stages),
-    };
-    Ok((times, warmup_frames))
+        warmup_frames,
+    })
 }
 
 fn print_table(rows: &[Row], ratios: bool) {
@@ -329,10 +331,6 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 }
                 Err(e) => ("-".to_string(), 0, "-".to_string(), Err(e.clone())),
             };
-            let (result, warmup_frames) = match result {
-                Ok((times, warmup_frames)) => (Ok(times), Some(warmup_frames)),
-                Err(e) => (Err(e), None),
-            };
             if let Err(e) = &result {
                 if !several {
                     bail!("{label}: {e}");
@@ -364,11 +362,20 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 ratio,
             };
             if args.json {
-                let (median, min, max, stages, error) = match &row.result {
-                    Ok(FrameTimes { frames: t, stages }) => {
-                        (Some(t.median), Some(t.min), Some(t.max), *stages, None)
-                    }
-                    Err(e) => (None, None, None, None, Some(e.clone())),
+                let (median, min, max, stages, warmup_frames, error) = match &row.result {
+                    Ok(FrameTimes {
+                        frames: t,
+                        stages,
+                        warmup_frames,
+                    }) => (
+                        Some(t.median),
+                        Some(t.min),
+                        Some(t.max),
+                        *stages,
+                        Some(*warmup_frames),
+                        None,
+                    ),
+                    Err(e) => (None, None, None, None, None, Some(e.clone())),
                 };
                 println!(
                     "{}",
