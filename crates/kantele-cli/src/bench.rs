@@ -6,6 +6,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{anyhow, bail, Result};
 use kantele::backend::{Backend, FrameView};
+use kantele::stats::FrameStats;
 use serde_json::json;
 
 use crate::backends::make_backend;
@@ -56,6 +57,35 @@ impl StageTimes {
     }
 }
 
+/// What the last timed frame drew, as the backend counts it ([`FrameStats`]): the same every
+/// frame for a fixed view, so frame times can be read per fragment or per triangle (the
+/// instructions-per-fragment figures of BENCHMARKS.md).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FrameWork {
+    /// Triangles handed to binning (after clipping, culling and degenerate removal).
+    pub triangles_binned: u64,
+    /// Triangle references written to tile bins.
+    pub bin_entries: u64,
+    /// Pixels covered by triangles, outside tiles rejected by depth.
+    pub fragments_covered: u64,
+    /// Fragments that passed the early depth test and were shaded.
+    pub fragments_shaded: u64,
+}
+
+impl FrameWork {
+    /// The counts of `stats`; `None` when it counts nothing (a backend that does not count,
+    /// such as OpenGL's).
+    pub fn of(stats: &FrameStats) -> Option<Self> {
+        let work = Self {
+            triangles_binned: stats.triangles_binned,
+            bin_entries: stats.bin_entries,
+            fragments_covered: stats.fragments_covered,
+            fragments_shaded: stats.fragments_shaded,
+        };
+        (work != Self::default()).then_some(work)
+    }
+}
+
 /// Timed frames: the whole frames, and their stages where the backend times them.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FrameTimes {
@@ -63,6 +93,8 @@ pub struct FrameTimes {
     pub frames: Timing,
     /// Median stage times.
     pub stages: Option<StageTimes>,
+    /// What the last timed frame drew, where the backend counts it.
+    pub work: Option<FrameWork>,
     /// Untimed warm-up frames rendered before them.
     pub warmup_frames: u64,
 }
@@ -141,6 +173,7 @@ fn time_frames(
         .map_err(|e| e.to_string())?;
     let mut times = Vec::with_capacity(frames as usize);
     let mut stages = Vec::with_capacity(frames as usize);
+    let mut work = None;
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1000.0;
     for _ in 0..frames {
         let start = Instant::now();
@@ -151,11 +184,13 @@ fn time_frames(
             ms(stats.binning_time),
             ms(stats.raster_time),
         ]);
+        work = FrameWork::of(&stats);
     }
     let frames = summarize(&times).ok_or_else(|| "no frames timed".to_string())?;
     Ok(FrameTimes {
         frames,
         stages: StageTimes::median_of(&stages),
+        work,
         warmup_frames,
     })
 }
@@ -362,20 +397,22 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 ratio,
             };
             if args.json {
-                let (median, min, max, stages, warmup_frames, error) = match &row.result {
+                let (median, min, max, stages, work, warmup_frames, error) = match &row.result {
                     Ok(FrameTimes {
                         frames: t,
                         stages,
+                        work,
                         warmup_frames,
                     }) => (
                         Some(t.median),
                         Some(t.min),
                         Some(t.max),
                         *stages,
+                        *work,
                         Some(*warmup_frames),
                         None,
                     ),
-                    Err(e) => (None, None, None, None, None, Some(e.clone())),
+                    Err(e) => (None, None, None, None, None, None, Some(e.clone())),
                 };
                 println!(
                     "{}",
@@ -392,6 +429,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                         "geometry_ms": stages.map(|s| s.geometry),
                         "binning_ms": stages.map(|s| s.binning),
                         "raster_ms": stages.map(|s| s.raster),
+                        "triangles_binned": work.map(|w| w.triangles_binned),
+                        "bin_entries": work.map(|w| w.bin_entries),
+                        "fragments_covered": work.map(|w| w.fragments_covered),
+                        "fragments_shaded": work.map(|w| w.fragments_shaded),
                         "ratio": row.ratio, "available": error.is_none(), "error": error,
                     })
                 );

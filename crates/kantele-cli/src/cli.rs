@@ -446,7 +446,8 @@ pub struct BenchArgs {
     pub cpu: CpuArgs,
     /// One JSON object per line instead of a table; with the medians of the CPU backend's
     /// stages too (`geometry_ms`, `binning_ms`, `raster_ms`; null for backends that do not time
-    /// them).
+    /// them) and what its last frame drew (`triangles_binned`, `bin_entries`,
+    /// `fragments_covered`, `fragments_shaded`; null for backends that do not count them).
     #[arg(long)]
     pub json: bool,
 }

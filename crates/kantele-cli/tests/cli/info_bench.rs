@@ -77,6 +77,22 @@ fn bench_two_frames() {
         );
     }
     assert!(v["raster_ms"].as_f64().unwrap() > 0.0, "{out}");
+    // And counts what it drew: the cube's front faces (of its 12 triangles, culling leaves at
+    // most 6), each in at least one tile; no pixel drawn twice (a convex solid, back faces
+    // culled), so covered fragments fit the picture, and every covered one is shaded (nothing
+    // lies in front of it).
+    let count = |name: &str| {
+        v[name]
+            .as_u64()
+            .unwrap_or_else(|| panic!("{name} in {out}"))
+    };
+    let binned = count("triangles_binned");
+    assert!((1..=6).contains(&binned), "{out}");
+    assert!(count("bin_entries") >= binned, "{out}");
+    let (width, height) = (count("width"), count("height"));
+    let covered = count("fragments_covered");
+    assert!(covered > 0 && covered <= width * height, "{out}");
+    assert_eq!(count("fragments_shaded"), covered, "{out}");
     let o = kantele(&[
         "bench",
         "--builtin",
