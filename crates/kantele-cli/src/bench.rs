@@ -173,7 +173,7 @@ fn time_frames(
         .map_err(|e| e.to_string())?;
     let mut times = Vec::with_capacity(frames as usize);
     let mut stages = Vec::with_capacity(frames as usize);
-    let mut work = None;
+    let mut last = None;
     let ms = |d: std::time::Duration| d.as_secs_f64() * 1000.0;
     for _ in 0..frames {
         let start = Instant::now();
@@ -184,13 +184,13 @@ fn time_frames(
             ms(stats.binning_time),
             ms(stats.raster_time),
         ]);
-        work = FrameWork::of(&stats);
+        last = Some(stats);
     }
     let frames = summarize(&times).ok_or_else(|| "no frames timed".to_string())?;
     Ok(FrameTimes {
         frames,
         stages: StageTimes::median_of(&stages),
-        work,
+        work: last.as_ref().and_then(FrameWork::of),
         warmup_frames,
     })
 }
@@ -397,23 +397,10 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                 ratio,
             };
             if args.json {
-                let (median, min, max, stages, work, warmup_frames, error) = match &row.result {
-                    Ok(FrameTimes {
-                        frames: t,
-                        stages,
-                        work,
-                        warmup_frames,
-                    }) => (
-                        Some(t.median),
-                        Some(t.min),
-                        Some(t.max),
-                        *stages,
-                        *work,
-                        Some(*warmup_frames),
-                        None,
-                    ),
-                    Err(e) => (None, None, None, None, None, None, Some(e.clone())),
-                };
+                // Every figure is null when the backend could not render the scene.
+                let timed = row.result.as_ref().ok();
+                let error = row.result.as_ref().err();
+                let (stages, work) = (timed.and_then(|t| t.stages), timed.and_then(|t| t.work));
                 println!(
                     "{}",
                     json!({
@@ -422,10 +409,12 @@ pub fn run(args: &BenchArgs) -> Result<()> {
                         "triangles": row.triangles, "draws": row.draws,
                         "backend": row.backend, "renderer": row.renderer, "threads": row.threads, "isa": row.isa, "target": row.target, "msaa": row.msaa,
                         "frames": args.frames, "warmup": args.warmup, "warmup_ms": args.warmup_ms,
-                        "warmup_frames": warmup_frames,
+                        "warmup_frames": timed.map(|t| t.warmup_frames),
                         // How this binary was compiled (build.rs): figures name their build.
                         "build": env!("KANTELE_BUILD"),
-                        "median_ms": median, "min_ms": min, "max_ms": max,
+                        "median_ms": timed.map(|t| t.frames.median),
+                        "min_ms": timed.map(|t| t.frames.min),
+                        "max_ms": timed.map(|t| t.frames.max),
                         "geometry_ms": stages.map(|s| s.geometry),
                         "binning_ms": stages.map(|s| s.binning),
                         "raster_ms": stages.map(|s| s.raster),
