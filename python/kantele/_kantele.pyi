@@ -29,7 +29,7 @@ def isa() -> str:
     the best level."""
 
 class Camera:
-    """A camera (conventions of `kantele_io::pose`, as the CLI's sidecar): the OpenGL camera
+    """A camera (conventions of `kantele_output::pose`, as the CLI's sidecar): the OpenGL camera
     frame looks down -Z with y up, the OpenCV frame down +Z with y down; intrinsics in pixels
     with the top-left pixel's centre at (0, 0); matrices row-major, points as columns. A camera
     may be tied to an image size (pinhole cameras always are)."""

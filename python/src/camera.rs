@@ -1,10 +1,10 @@
-//! `kantele.Camera`: a [`CameraPose`] from `kantele_io::pose` — the conventions the CLI and its
+//! `kantele.Camera`: a [`CameraPose`] from `kantele_output::pose` — the conventions the CLI and its
 //! JSON sidecar use — with an optional image size.
 
 use glam::{Mat4, Vec3};
 use kantele::backend::{FrameView, Pass};
 use kantele::scene::Scene;
-use kantele_io::pose::{
+use kantele_output::pose::{
     self, sidecar::SidecarCamera, Bounds, CameraPose, Intrinsics, PoseError, Projection, UpAxis,
 };
 use numpy::ndarray::Array2;
@@ -21,7 +21,7 @@ pub const ORBIT_YFOV_DEG: f32 = 45.0;
 
 /// A camera: where it is, how it projects, its depth range and, when it has one, its image size.
 ///
-/// Conventions (`kantele_io::pose`): the OpenGL camera frame looks down −Z with y up; the OpenCV
+/// Conventions (`kantele_output::pose`): the OpenGL camera frame looks down −Z with y up; the OpenCV
 /// frame looks down +Z with y down; intrinsics are in pixels with the top-left pixel's centre at
 /// (0, 0); matrices are row-major with points as columns.
 #[pyclass(name = "Camera", module = "kantele", frozen, from_py_object)]

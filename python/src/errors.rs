@@ -4,7 +4,7 @@ use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueEr
 use pyo3::PyErr;
 
 use kantele::error::RenderError;
-use kantele_io::LoadError;
+use kantele_scene::LoadError;
 
 /// A loader error: unreadable files are `OSError` (`FileNotFoundError` when missing), malformed
 /// or unknown files are `ValueError`.

@@ -1,4 +1,4 @@
-//! Writing images from Python with the CLI's writers (`kantele_io::output`).
+//! Writing images from Python with the CLI's writers (`kantele_output::output`).
 
 use std::path::PathBuf;
 
@@ -27,6 +27,6 @@ pub fn write_png(py: Python<'_>, path: PathBuf, image: PyReadonlyArray3<'_, u8>)
         Ok(slice) => slice.to_vec(),
         Err(_) => image.as_array().iter().copied().collect(),
     };
-    py.detach(|| kantele_io::output::write_png_rgba8(&path, w, h, &data))
+    py.detach(|| kantele_output::output::write_png_rgba8(&path, w, h, &data))
         .map_err(|e| PyOSError::new_err(e.to_string()))
 }

@@ -1,5 +1,5 @@
 //! `kantele._kantele`: the Python extension module behind the `kantele` package (see
-//! `python/kantele/__init__.py`). It wraps the public API of `kantele` and `kantele-io`: scenes
+//! `python/kantele/__init__.py`). It wraps the public API of `kantele` and `kantele-scene`: scenes
 //! load through the same loaders and render through the same backends as the `kantele` command.
 
 mod arrays;

@@ -246,6 +246,6 @@ pub fn scene_from_arrays(arrays: &MeshArrays<'_>, double_sided: bool) -> PyResul
         node_index: 0,
     });
     scene.validate().map_err(render_error)?;
-    scene.camera = kantele_io::mesh_util::framing_camera(&scene);
+    scene.camera = kantele_scene::mesh_util::framing_camera(&scene);
     Ok(scene)
 }

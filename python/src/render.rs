@@ -4,7 +4,7 @@
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::error::RenderError;
 use kantele::scene::Scene;
-use kantele_io::pose::CameraPose;
+use kantele_output::pose::CameraPose;
 
 /// One array `Scene.render` can return.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

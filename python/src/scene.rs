@@ -17,7 +17,7 @@ use crate::camera::{self, pose_error, PyCamera, ORBIT_ELEVATION_DEG, ORBIT_YFOV_
 use crate::errors::{load_error, render_error, value_error};
 use crate::mesh_arrays::{scene_from_arrays, MeshArrays};
 use crate::render::{render_views, OutputKind, RenderedView};
-use kantele_io::pose::CameraPose;
+use kantele_output::pose::CameraPose;
 
 /// A CPU backend with this scene loaded, kept between calls.
 struct CachedCpu {
@@ -51,7 +51,7 @@ impl PyScene {
     /// Loads a scene file (glTF or OBJ) with the GIL released.
     pub fn load_path(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
         let loaded = py
-            .detach(|| kantele_io::load_scene(&path))
+            .detach(|| kantele_scene::load_scene(&path))
             .map_err(load_error)?;
         Self::new(loaded.scene, loaded.info.source, loaded.info.warnings)
     }
@@ -314,7 +314,7 @@ impl PyScene {
     /// A built-in scene by name: `cube`, `teapot`, `ground` or `pixel-edges`.
     #[staticmethod]
     fn builtin(name: &str) -> PyResult<Self> {
-        let loaded = kantele_io::builtin_scene(name).map_err(load_error)?;
+        let loaded = kantele_scene::builtin_scene(name).map_err(load_error)?;
         Self::new(loaded.scene, loaded.info.source, loaded.info.warnings)
     }
 

@@ -5,7 +5,7 @@ use std::io::{self, Write};
 use std::path::Path;
 
 use kantele::backend::FrameImage;
-use kantele_io::output::OutputSet;
+use kantele_output::output::OutputSet;
 
 use crate::output::extension;
 

@@ -4,9 +4,9 @@
 use anyhow::{anyhow, bail, Result};
 use glam::Vec3;
 use kantele::scene::NamedCamera;
-use kantele_io::pose::sidecar::{read_views_file, ViewDefaults};
-use kantele_io::pose::{Bounds, CameraPose, UpAxis};
-use kantele_io::LoadedScene;
+use kantele_output::pose::sidecar::{read_views_file, ViewDefaults};
+use kantele_output::pose::{Bounds, CameraPose, UpAxis};
+use kantele_scene::LoadedScene;
 
 use crate::cli::{CameraArgs, UpArg};
 
@@ -195,7 +195,7 @@ impl CameraPlan {
         height: u32,
         label: &str,
     ) -> Result<Vec<CameraPose>> {
-        let pose_err = |e: kantele_io::pose::PoseError| anyhow!("{label}: camera: {}", e.0);
+        let pose_err = |e: kantele_output::pose::PoseError| anyhow!("{label}: camera: {}", e.0);
         if let Some(views) = &self.views {
             return Ok(views.clone());
         }
@@ -349,7 +349,7 @@ mod tests {
     }
 
     fn cube() -> LoadedScene {
-        kantele_io::builtin_scene("cube").unwrap()
+        kantele_scene::builtin_scene("cube").unwrap()
     }
 
     #[test]
@@ -375,7 +375,7 @@ mod tests {
         let pose = &plan.poses(&loaded, 64, 48, "cube").unwrap()[0];
         assert!(matches!(
             pose.projection,
-            kantele_io::pose::Projection::Orthographic { .. }
+            kantele_output::pose::Projection::Orthographic { .. }
         ));
     }
 
@@ -391,7 +391,7 @@ mod tests {
         assert_eq!(
             matches!(
                 pose.projection,
-                kantele_io::pose::Projection::Orthographic { .. }
+                kantele_output::pose::Projection::Orthographic { .. }
             ),
             ortho
         );

@@ -1,6 +1,6 @@
-//! Tolerances for `kantele compare`, checked against [`kantele_io::compare::Comparison`].
+//! Tolerances for `kantele compare`, checked against [`kantele_testkit::compare::Comparison`].
 
-use kantele_io::compare::Comparison;
+use kantele_testkit::compare::Comparison;
 
 /// Limits a comparison must stay within.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -61,12 +61,12 @@ mod tests {
         let a = frame([0.0, 0.0, 0.0, 1.0], 0.5, 100);
         let mut b = a.clone();
         b.depth[0] = 1.0;
-        let c = kantele_io::compare::compare(&a, &b, None, 255).expect("same size");
+        let c = kantele_testkit::compare::compare(&a, &b, None, 255).expect("same size");
         let v = violations(&c, &Tolerances::default());
         assert_eq!(v.len(), 1, "{v:?}");
         assert!(v[0].contains("--max-coverage-diff"));
         b.color = vec![[1.0, 1.0, 1.0, 1.0]; 100];
-        let c = kantele_io::compare::compare(&a, &b, None, 255).expect("same size");
+        let c = kantele_testkit::compare::compare(&a, &b, None, 255).expect("same size");
         let v = violations(
             &c,
             &Tolerances {

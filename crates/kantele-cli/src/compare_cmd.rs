@@ -85,7 +85,7 @@ pub fn run(args: &CompareArgs) -> Result<bool> {
             for j in i + 1..frames.len() {
                 let (na, fa) = &frames[i];
                 let (nb, fb) = &frames[j];
-                let m = kantele_io::compare::compare(fa, fb, None, u8::MAX)
+                let m = kantele_testkit::compare::compare(fa, fb, None, u8::MAX)
                     .ok_or_else(|| anyhow!("{label}: {na} and {nb} frames differ in size"))?;
                 if let Some(dir) = &args.out {
                     let name = if frames.len() == 2 {

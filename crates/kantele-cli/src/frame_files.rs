@@ -8,8 +8,8 @@ use anyhow::{anyhow, bail, Result};
 use glam::{Mat3, Vec3};
 use kantele::backend::FrameImage;
 use kantele::scene::Scene;
-use kantele_io::output::OutputSet;
-use kantele_io::pose::CameraPose;
+use kantele_output::output::OutputSet;
+use kantele_output::pose::CameraPose;
 
 use crate::cli::{DepthKind, DepthUnit, IdKind, NormalSpace};
 use crate::output::extension;

@@ -1,7 +1,7 @@
 //! The files of one image written a band of rows at a time: each output (colour, depth,
 //! normals, one per id kind) is opened once in the frame's [`OutputSet`], fed every band of
 //! its pass top to bottom, and finished before the sidecar is written. PNG, PFM and `.npy` are
-//! streamed ([`kantele_io::row_writer`]); OpenEXR is written whole and so only for pictures
+//! streamed ([`kantele_output::row_writer`]); OpenEXR is written whole and so only for pictures
 //! rendered in one band.
 
 use std::io::{Cursor, Write};
@@ -10,12 +10,12 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Result};
 use kantele::backend::FrameImage;
 use kantele::scene::Scene;
-use kantele_io::output::{
+use kantele_output::output::{
     close_file, encode_exr_gray32f, encode_exr_gray_u32, encode_exr_rgb32f, encode_exr_rgba32f,
     FileWriter, OutputSet,
 };
-use kantele_io::pose::CameraPose;
-use kantele_io::row_writer::{RowWriter, Rows, SampleKind};
+use kantele_output::pose::CameraPose;
+use kantele_output::row_writer::{RowWriter, Rows, SampleKind};
 
 use crate::cli::{DepthKind, DepthUnit, IdKind, NormalSpace};
 use crate::frame_files::{depth_png, depth_values, id_values, normal_values};

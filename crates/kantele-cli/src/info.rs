@@ -2,7 +2,7 @@
 
 use anyhow::{bail, Result};
 use kantele::scene::{AlphaMode, Light, Scene};
-use kantele_io::LoadedScene;
+use kantele_scene::LoadedScene;
 use serde_json::{json, Value};
 
 use crate::cli::InfoArgs;

@@ -1,6 +1,6 @@
 //! The `kantele` command: render, inspect, benchmark, compare and view scenes.
 //!
-//! Scenes are glTF 2.0 / OBJ files (loaded by `kantele-io`) or built-ins (`--builtin cube`),
+//! Scenes are glTF 2.0 / OBJ files (loaded by `kantele-scene`) or built-ins (`--builtin cube`),
 //! drawn by the rules of the reference scenes. Backends are `cpu` (Kantele) and `gl` (the
 //! OpenGL reference, `kantele-gl`).
 //!

@@ -1,7 +1,7 @@
 //! Output file names: templates with `{stem}`, `{index}` and `{frame}`. The writers themselves
-//! are in [`kantele_io::output`] (shared with the Python package).
+//! are in [`kantele_output::output`] (shared with the Python package).
 
-pub use kantele_io::output::write_png_rgba8;
+pub use kantele_output::output::write_png_rgba8;
 
 use std::path::Path;
 

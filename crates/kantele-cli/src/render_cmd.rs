@@ -14,11 +14,11 @@ use kantele::band::{plan_bands, TARGET_BYTES_PER_PIXEL};
 use kantele::scene::Scene;
 use kantele::stats::FrameStats;
 use kantele::RenderError;
-use kantele_io::output::OutputSet;
-use kantele_io::pose::sidecar::{AnimationSidecar, InstanceId, PrimitiveId, SidecarCamera};
-use kantele_io::pose::sidecar::{SidecarDepth, SidecarIds};
-use kantele_io::pose::sidecar::{SidecarNormals, MATRIX_LAYOUT};
-use kantele_io::pose::{rows, CameraPose, Sidecar};
+use kantele_output::output::OutputSet;
+use kantele_output::pose::sidecar::{AnimationSidecar, InstanceId, PrimitiveId, SidecarCamera};
+use kantele_output::pose::sidecar::{SidecarDepth, SidecarIds};
+use kantele_output::pose::sidecar::{SidecarNormals, MATRIX_LAYOUT};
+use kantele_output::pose::{rows, CameraPose, Sidecar};
 use serde_json::json;
 
 use crate::animation::{is_animation, Animation, ANIMATION_TYPES};

@@ -4,7 +4,7 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
-use kantele_io::{LoadOptions, LoadedScene};
+use kantele_scene::{LoadOptions, LoadedScene};
 
 use crate::cli::SceneArgs;
 
@@ -56,10 +56,10 @@ impl Input {
     pub fn load(&self) -> Result<LoadedScene> {
         let loaded = match self {
             Input::File(p, options) => {
-                kantele_io::load_scene_with(p, options).map_err(|e| anyhow!("{e}"))?
+                kantele_scene::load_scene_with(p, options).map_err(|e| anyhow!("{e}"))?
             }
             Input::Builtin(n) => {
-                kantele_io::builtin_scene(n).map_err(|e| anyhow!("{}: {e}", self.label()))?
+                kantele_scene::builtin_scene(n).map_err(|e| anyhow!("{}: {e}", self.label()))?
             }
         };
         loaded
@@ -115,7 +115,7 @@ fn pattern_scenes(pattern: &str) -> Result<Vec<PathBuf>> {
 pub fn inputs(args: &SceneArgs) -> Result<Vec<Input>> {
     let mut out = Vec::new();
     let options = LoadOptions {
-        max_memory: args.max_memory.unwrap_or(kantele_io::DEFAULT_MAX_MEMORY),
+        max_memory: args.max_memory.unwrap_or(kantele_scene::DEFAULT_MAX_MEMORY),
         allow_read: args.allow_read.clone(),
         strict: args.strict,
         ..LoadOptions::default()
@@ -137,7 +137,7 @@ pub fn inputs(args: &SceneArgs) -> Result<Vec<Input>> {
             Err(e) => bail!("{}: {e}", p.display()),
         }
     }
-    let known = kantele_io::builtin_scenes();
+    let known = kantele_scene::builtin_scenes();
     for n in &args.builtins {
         if !known.iter().any(|(name, _)| name == n) {
             let names: Vec<&str> = known.iter().map(|(n, _)| *n).collect();

@@ -6,7 +6,7 @@ use std::sync::Arc;
 use anyhow::{anyhow, Result};
 use kantele::backend::Pass;
 use kantele::multisample::SampleCount;
-use kantele_io::output::{encode_png_rgba8, write_atomic};
+use kantele_output::output::{encode_png_rgba8, write_atomic};
 
 use crate::backends::make_backend;
 use crate::camera_args::CameraPlan;

@@ -3,21 +3,21 @@
 
 use std::mem::size_of;
 
-use kantele::fixed;
-use kantele::geometry::clip::{MAX_CLIPPED_VERTICES, W_EPSILON};
-use kantele::material::StandardVertex;
-use kantele::setup::TriangleSetup;
-use kantele::shade::texture::{Filter, MinFilter, Wrap};
+use kantele_rules::fixed;
+use kantele_rules::geometry::clip::{MAX_CLIPPED_VERTICES, W_EPSILON};
+use kantele_rules::setup::TriangleSetup;
+use kantele_rules::shade::texture::{Filter, MinFilter, Wrap};
+use kantele_rules::vertex::StandardVertex;
 
 use crate::records::{
     filter_code, min_filter_code, pass_code, wrap_code, DrawIssue, DrawRecord, FrameUniforms,
     LevelRecord, SlotInfo, TextureRecord, DRAW_ALPHA_BLEND, DRAW_ALPHA_MASK, DRAW_DOUBLE_SIDED,
     DRAW_EMISSIVE_TEXTURED, DRAW_FRONT_CW, DRAW_TEXTURED, DRAW_UNLIT, DRAW_VERTEX_COLORS,
 };
-use kantele::backend::Pass;
+use kantele_rules::backend::Pass;
 
 /// Varyings of the built-in material shader: world normal (3), texcoord (2), colour (4).
-/// `kantele::material` keeps its count private; a test checks this against
+/// `kantele_rules::material` keeps its count private; a test checks this against
 /// `MaterialShader::varying_count`.
 pub const MATERIAL_VARYINGS: usize = 9;
 
@@ -45,7 +45,10 @@ pub fn defines() -> Vec<(String, String)> {
     int("KANTELE_TILE_LOG2", fixed::TILE_LOG2 as i64);
     int("KANTELE_BLOCK_LOG2", fixed::BLOCK_LOG2 as i64);
     int("KANTELE_SUBPIXEL_LIMIT", fixed::SUBPIXEL_LIMIT);
-    int("KANTELE_SMALL_BOX_PIXELS", kantele::setup::SMALL_BOX_PIXELS);
+    int(
+        "KANTELE_SMALL_BOX_PIXELS",
+        kantele_rules::setup::SMALL_BOX_PIXELS,
+    );
     int("KANTELE_MAX_CLIPPED_VERTICES", MAX_CLIPPED_VERTICES as i64);
     int("KANTELE_VARYINGS", MATERIAL_VARYINGS as i64);
     int("KANTELE_BIN_CHUNK", BIN_CHUNK as i64);
@@ -139,7 +142,7 @@ mod tests {
     use glam::Mat4;
     use kantele::material::{Lighting, MaterialShader};
     use kantele::pipeline::Shader;
-    use kantele::scene::Material;
+    use kantele_rules::scene::Material;
 
     #[test]
     fn material_varying_count_matches_the_core() {

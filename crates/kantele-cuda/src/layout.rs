@@ -4,7 +4,7 @@
 
 use std::mem::offset_of;
 
-use kantele::setup::TriangleSetup;
+use kantele_rules::setup::TriangleSetup;
 
 use crate::records::{DrawRecord, FrameUniforms, LevelRecord};
 

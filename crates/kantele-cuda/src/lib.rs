@@ -1,9 +1,9 @@
 //! The CUDA backend of Kantele: the whole pipeline — vertex transform, clipping, culling,
 //! fixed-point setup, binning, fine rasterization, materials and blending — on an NVIDIA GPU,
 //! by the CPU backend's rules, so that coverage and depth are bit-identical to
-//! [`kantele::cpu::CpuBackend`].
+//! the CPU backend (`kantele::cpu::CpuBackend`).
 //!
-//! The entry point is [`CudaBackend`], a [`kantele::backend::Backend`]. The CUDA driver
+//! The entry point is [`CudaBackend`], a [`kantele_rules::backend::Backend`]. The CUDA driver
 //! (`libcuda`) and NVRTC (`libnvrtc`) are opened at run time, so this crate builds, and
 //! programs using it run, on machines without CUDA: [`CudaBackend::new`] then returns a
 //! one-line error.

@@ -2,7 +2,7 @@
 //! tile grid and binning chunks of a frame, the buffer capacities and how they grow after an
 //! overflow, the levels of the device-wide scan, and the fixed sequence of launches of a frame.
 
-use kantele::fixed::TILE_SIZE;
+use kantele_rules::fixed::TILE_SIZE;
 
 use crate::defines::BIN_CHUNK;
 use crate::records::MAX_FRAME_ELEMENTS;

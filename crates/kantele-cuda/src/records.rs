@@ -3,12 +3,12 @@
 //! checked there with `static_assert`), and their construction from a [`Scene`].
 
 use glam::Mat4;
-use kantele::backend::Pass;
-use kantele::camera::normal_matrix;
-use kantele::material::StandardVertex;
-use kantele::scene::{AlphaMode, Scene};
-use kantele::setup::FrontFace;
-use kantele::shade::texture::{Filter, MinFilter, Sampler, Wrap};
+use kantele_rules::backend::Pass;
+use kantele_rules::camera::normal_matrix;
+use kantele_rules::scene::{AlphaMode, Scene};
+use kantele_rules::setup::FrontFace;
+use kantele_rules::shade::texture::{Filter, MinFilter, Sampler, Wrap};
+use kantele_rules::vertex::StandardVertex;
 
 /// `DrawRecord::flags`: the material is unlit (`KHR_materials_unlit`).
 pub const DRAW_UNLIT: u32 = 1 << 0;
@@ -98,7 +98,7 @@ impl SamplerCodes {
 pub struct DrawRecord {
     /// Model matrix, column-major.
     pub model: [f32; 16],
-    /// Normal matrix (`kantele::camera::normal_matrix`), column-major.
+    /// Normal matrix (`kantele_rules::camera::normal_matrix`), column-major.
     pub normal_matrix: [f32; 9],
     /// The material's base colour factor.
     pub base_color_factor: [f32; 4],
@@ -437,8 +437,8 @@ pub fn view_projection(projection: &Mat4, view: &Mat4) -> [f32; 16] {
 mod tests {
     use super::*;
     use glam::{Vec3, Vec4};
-    use kantele::scene::{Draw, Material, Mesh, TextureBinding};
-    use kantele::shade::texture::{Sampler, Texture};
+    use kantele_rules::scene::{Draw, Material, Mesh, TextureBinding};
+    use kantele_rules::shade::texture::{Sampler, Texture};
     use std::sync::Arc;
 
     fn triangle_mesh(material: usize) -> Mesh {

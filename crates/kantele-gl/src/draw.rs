@@ -3,11 +3,11 @@
 
 use glam::{Mat3, Mat4, Vec4};
 use glow::HasContext;
-use kantele::backend::{FrameView, Pass};
-use kantele::camera::normal_matrix;
-use kantele::scene::{AlphaMode, Scene, Topology};
-use kantele::stats::FrameStats;
-use kantele::RenderError;
+use kantele_rules::backend::{FrameView, Pass};
+use kantele_rules::camera::normal_matrix;
+use kantele_rules::scene::{AlphaMode, Scene, Topology};
+use kantele_rules::stats::FrameStats;
+use kantele_rules::RenderError;
 
 use crate::{shaders, GlBackend};
 
@@ -99,8 +99,8 @@ impl GlBackend {
                 // The y-flip mirrors the winding: front (CCW in NDC) is CW in GL's window; a
                 // mirroring model matrix flips it once more.
                 gl.front_face(match draw.front_face() {
-                    kantele::setup::FrontFace::Ccw => glow::CW,
-                    kantele::setup::FrontFace::Cw => glow::CCW,
+                    kantele_rules::setup::FrontFace::Ccw => glow::CW,
+                    kantele_rules::setup::FrontFace::Cw => glow::CCW,
                 });
                 if material.double_sided {
                     gl.disable(glow::CULL_FACE);

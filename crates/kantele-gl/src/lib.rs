@@ -5,22 +5,22 @@
 //!
 //! The entry point is [`GlBackend`]: [`GlBackend::new`] creates the context (or returns an
 //! error when no EGL/OpenGL is available), and the [`Backend`] trait does the rest: `load` a
-//! scene once, `render` a [`kantele::backend::FrameView`], then `read_frame`. The
+//! scene once, `render` a [`kantele_rules::backend::FrameView`], then `read_frame`. The
 //! `unsafe` GL and EGL calls of the workspace live in this crate. The core `kantele` crate
 //! forbids `unsafe`.
 //!
 //! ```no_run
 //! use std::sync::Arc;
-//! use kantele::backend::{Backend, FrameView};
-//! use kantele::scene::Scene;
+//! use kantele_rules::backend::{Backend, FrameView};
+//! use kantele_rules::scene::Scene;
 //!
 //! # fn scene() -> Scene { unimplemented!() }
-//! let scene = Arc::new(scene()); // e.g. from kantele-io
+//! let scene = Arc::new(scene()); // e.g. from kantele-scene
 //! let mut gl = kantele_gl::GlBackend::new()?;
 //! gl.load(scene.clone())?;
 //! gl.render(&FrameView::of_scene(&scene))?;
 //! let image = gl.read_frame()?; // linear RGBA + depth, row 0 = top
-//! # Ok::<(), kantele::RenderError>(())
+//! # Ok::<(), kantele_rules::RenderError>(())
 //! ```
 //!
 //! # How the rules map onto GL
@@ -87,14 +87,14 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use glow::HasContext;
-use kantele::backend::{Backend, FrameImage, FrameView, Pass};
-use kantele::multisample::SampleCount;
-use kantele::scene::Scene;
-use kantele::stats::FrameStats;
-use kantele::RenderError;
+use kantele_rules::backend::{Backend, FrameImage, FrameView, Pass};
+use kantele_rules::multisample::SampleCount;
+use kantele_rules::scene::Scene;
+use kantele_rules::stats::FrameStats;
+use kantele_rules::RenderError;
 
 #[cfg(doc)]
-use kantele::shade::texture::Texture;
+use kantele_rules::shade::texture::Texture;
 
 use crate::egl::EglContext;
 use crate::program::{build_program, uniforms, Uniforms};
@@ -322,7 +322,7 @@ impl Backend for GlBackend {
             .clone()
             .ok_or_else(|| backend_error("render called before load"))?;
         let (width, height) = (view.width, view.height);
-        let side_ok = |s: u32| (1..=kantele::MAX_TARGET_SIZE).contains(&s);
+        let side_ok = |s: u32| (1..=kantele_rules::MAX_TARGET_SIZE).contains(&s);
         if !side_ok(width) || !side_ok(height) {
             return Err(RenderError::InvalidSize { width, height });
         }

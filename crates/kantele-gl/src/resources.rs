@@ -2,9 +2,9 @@
 //! SRGB8_ALPHA8 texture with its complete mip chain per texture, one sampler object per textured material.
 
 use glow::HasContext;
-use kantele::material::StandardVertex;
-use kantele::scene::{Material, Mesh, Scene};
-use kantele::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
+use kantele_rules::scene::{Material, Mesh, Scene};
+use kantele_rules::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
+use kantele_rules::vertex::StandardVertex;
 
 /// Floats per vertex: position 3, normal 3, texcoord 2, colour 4.
 pub(crate) const VERTEX_FLOATS: usize = 12;

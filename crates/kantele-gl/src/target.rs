@@ -3,8 +3,8 @@
 //! resolve between them.
 
 use glow::HasContext;
-use kantele::multisample::SampleCount;
-use kantele::RenderError;
+use kantele_rules::multisample::SampleCount;
+use kantele_rules::RenderError;
 
 use crate::{backend_error, unsupported, GlBackend};
 

@@ -22,7 +22,7 @@ use kantele::setup::CullMode;
 use kantele::shade::texture::{MinFilter, Sampler, Wrap};
 use kantele::stats::FrameStats;
 use kantele::RenderError;
-use kantele_io::texture_util::checker;
+use kantele_scene::texture_util::checker;
 
 /// The thesis' vertex: position, colour and texture coordinate.
 #[derive(Clone, Copy, Debug)]

@@ -5,11 +5,15 @@
 //! `gl,display,scenes`) names what it lacks: then it fails, so a CI machine that is meant to have
 //! the thing can never pass by skipping. `.ci/run` sets `KANTELE_REQUIRE` for what CI installs.
 //!
+//! [`compare`] measures how two renderings of one frame differ (coverage, colour, depth, a
+//! difference image): `kantele compare` and the OpenGL agreement tests use it.
+//!
 //! [`demo`] holds the seed documents' two scenes written against the pipeline API, which the
 //! core's reference-image and band tests and its `seeds` example render.
 #![warn(missing_docs)]
 #![forbid(unsafe_code)]
 
+pub mod compare;
 pub mod demo;
 
 use std::fmt::Display;

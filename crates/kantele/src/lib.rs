@@ -49,87 +49,43 @@
 //! `kantele_testkit::demo` draws two complete scenes (a textured cube, a lit and blended scene)
 //! the same way.
 //!
-//! # Conventions
+//! # Layers
 //!
-//! - **Clip space** is OpenGL's: `-w ≤ x, y, z ≤ w`; NDC x points right and y up. Window depth
-//!   is `(z/w + 1) / 2` in `[0, 1]`, cleared to 1; fragments outside `[0, 1]` are discarded
-//!   (there is no far-plane clipping). The near plane and the guard band are clipped
-//!   ([`geometry::clip`]).
-//! - **Pixels**: row 0 is the top row of the image; pixel `(x, y)` is sampled at its centre
-//!   `(x + 0.5, y + 0.5)`. Vertices snap to 1/256 pixel ([`fixed::SUBPIXEL_BITS`] = 8, round
-//!   half to even).
-//! - **Winding**: counter-clockwise in NDC is front by default
-//!   ([`setup::FrontFace::Ccw`]); back faces are culled by default ([`setup::CullMode::Back`]).
-//! - **Fill rule**: top-left, as in Direct3D and OpenGL implementations — a pixel centre
-//!   exactly on an edge belongs to the triangle only if the edge is a top or left edge, so
-//!   triangles sharing an edge cover each of its pixels exactly once.
-//! - **Colour** is linear `f32` RGBA throughout; blending happens in linear space, and sRGB
-//!   encoding happens only on read-back ([`rop::Framebuffer::read_rgba8`]). Textures decode
-//!   sRGB when created ([`shade::texture`]).
-//! - **Texture coordinates**: `(0, 0)` is the top-left of the image (glTF's convention).
+//! This crate is the library's one front door: it re-exports, under the paths used
+//! everywhere, three crates that each hold one layer.
 //!
-//! # Modules
+//! - **Lanes** (`kantele-lanes`, here [`simd`]): 8-lane types per instruction set, chosen
+//!   once at run time, identical bits on every one. All of the CPU path's `unsafe` lives there.
+//! - **Rules** (`kantele-rules`): what a picture is — [`fixed`] point, [`geometry`] clipping,
+//!   triangle [`setup`], render [`state`] (depth, blend, limits, ids), [`multisample`]
+//!   positions, texture sampling ([`shade`]), [`color`], [`camera`], the [`scene`] data and
+//!   its [`vertex`] layout, the [`backend`] interface, [`stats`] and [`error`]. Every backend
+//!   (CPU, OpenGL, CUDA) stands on it. Its crate docs state the conventions (clip space,
+//!   pixels, winding, fill rule, colour, texture coordinates).
+//! - **CPU** (`kantele-cpu`): the programmable [`pipeline`] (shaders, renderer, frame,
+//!   workers), binning and traversal ([`raster`]), the output merger and framebuffer
+//!   ([`rop`]), the built-in [`material`] shaders, the [`cpu`] backend and [`band`]ed
+//!   rendering of big pictures.
 //!
-//! In pipeline order:
-//!
-//! - [`pipeline`] — [`Shader`](pipeline::Shader), [`Renderer`](pipeline::Renderer),
-//!   [`Frame`](pipeline::Frame): the programmable API and the frame that runs every stage.
-//! - [`geometry`] — primitive stage: trivial reject and clipping in homogeneous clip space.
-//! - [`fixed`] — the fixed-point rules: sub-pixel bits, tile and block sizes, guard band.
-//! - [`setup`] — triangle setup: viewport transform, snapping, culling, integer edge
-//!   functions with the fill rule as a bias ([`TriangleSetup`](setup::TriangleSetup)).
-//! - [`raster`] — binning into tiles ([`raster::bin`]) and the five traversal strategies.
-//! - [`shade`] — textures, samplers, mip chains and level of detail.
-//! - [`rop`] — depth test, blending, and the tiled framebuffer.
-//! - [`multisample`] — multisample antialiasing: sample counts, standard positions, limits.
-//! - [`stats`] — per-stage counters and timings of a frame.
-//!
-//! Scenes and backends:
-//!
-//! - [`scene`] — plain scene data (meshes, materials, textures, draws, camera, light).
-//! - [`material`] — the built-in material shader implementing the reference-scene rules.
-//! - [`backend`] — the [`Backend`](backend::Backend) trait shared by CPU and OpenGL.
-//! - [`cpu`] — the CPU backend: scenes through the pipeline with the built-in materials.
-//! - [`camera`] — view and projection matrices (OpenGL conventions).
-//! - [`color`] — the sRGB transfer curves and 8-bit quantisation.
-//! - [`error`] — [`RenderError`].
-//! - `fault` — planted bugs for testing the test tools (only with the `fault-injection`
-//!   feature, switched on by `KANTELE_FAULT`).
-//!
-//! `ARCHITECTURE.md` at the repository root describes the data flow, the fixed-point and
-//! interpolation rules, why pictures are deterministic, and how the crate is tested.
+//! `ARCHITECTURE.md` at the repository root draws the layers and the data flow of a frame.
 #![warn(missing_docs)]
-#![deny(unsafe_code)]
+#![forbid(unsafe_code)]
 
-pub mod backend;
-pub mod band;
-pub mod camera;
-pub mod color;
-pub mod cpu;
-pub mod error;
+pub use kantele_lanes as simd;
+
+pub use kantele_rules::{
+    backend, camera, color, error, fixed, geometry, multisample, scene, setup, shade, state, stats,
+    vertex,
+};
+pub use kantele_rules::{RenderError, MAX_TARGET_SIZE, MAX_VARYINGS};
+
 #[cfg(feature = "fault-injection")]
-pub mod fault;
-pub mod fixed;
-/// Bodies of the fuzz targets in `fuzz/`, callable from stable tests (not a public API).
-#[doc(hidden)]
-pub mod fuzz_targets;
-pub mod geometry;
-pub mod material;
-pub mod multisample;
-pub mod pipeline;
-pub mod raster;
+pub use kantele_rules::fault;
 /// The exact coverage reference of the tests and the `raster` fuzz target (not a public API).
 #[doc(hidden)]
-pub mod reference;
-pub mod rop;
-pub mod scene;
-pub mod setup;
-pub mod shade;
-#[allow(unsafe_code)]
-pub mod simd;
-pub mod state;
-pub mod stats;
+pub use kantele_rules::reference;
 
-pub use error::RenderError;
-
-pub use state::{MAX_TARGET_SIZE, MAX_VARYINGS};
+/// Bodies of the fuzz targets in `fuzz/`, callable from stable tests (not a public API).
+#[doc(hidden)]
+pub use kantele_cpu::fuzz_targets;
+pub use kantele_cpu::{band, cpu, material, pipeline, raster, rop};

@@ -6,9 +6,9 @@ use std::mem::size_of;
 use std::sync::Arc;
 
 use cudarc::driver::{CudaSlice, DevicePtr, DeviceRepr, ValidAsZeroBits};
-use kantele::scene::Scene;
-use kantele::setup::TriangleSetup;
-use kantele::RenderError;
+use kantele_rules::scene::Scene;
+use kantele_rules::setup::TriangleSetup;
+use kantele_rules::RenderError;
 
 use super::{failed, CudaBackend};
 use crate::defines::{MATERIAL_VARYINGS, STATUS_WORDS};

@@ -5,10 +5,10 @@
 use std::mem::size_of;
 
 use cudarc::driver::{CudaSlice, LaunchConfig, PushKernelArg};
-use kantele::backend::{FrameView, Pass};
-use kantele::geometry::clip::GuardBand;
-use kantele::setup::{PixelRect, TriangleSetup};
-use kantele::RenderError;
+use kantele_rules::backend::{FrameView, Pass};
+use kantele_rules::geometry::clip::GuardBand;
+use kantele_rules::setup::{PixelRect, TriangleSetup};
+use kantele_rules::RenderError;
 
 use super::device::{FrameBuffers, SceneBuffers};
 use super::{failed, CudaBackend};

@@ -18,10 +18,10 @@ use cudarc::driver::{
     sys, CudaContext, CudaEvent, CudaFunction, CudaStream, LaunchConfig, PushKernelArg,
 };
 use cudarc::nvrtc::Ptx;
-use kantele::backend::{Backend, FrameImage, FrameView};
-use kantele::scene::Scene;
-use kantele::stats::FrameStats;
-use kantele::RenderError;
+use kantele_rules::backend::{Backend, FrameImage, FrameView};
+use kantele_rules::scene::Scene;
+use kantele_rules::stats::FrameStats;
+use kantele_rules::RenderError;
 
 use self::device::{FrameBuffers, SceneBuffers};
 use self::launch::status;
@@ -271,8 +271,8 @@ impl Backend for CudaBackend {
         let wall = Instant::now();
         if view.width == 0
             || view.height == 0
-            || view.width > kantele::MAX_TARGET_SIZE
-            || view.height > kantele::MAX_TARGET_SIZE
+            || view.width > kantele_rules::MAX_TARGET_SIZE
+            || view.height > kantele_rules::MAX_TARGET_SIZE
         {
             return Err(RenderError::InvalidSize {
                 width: view.width,

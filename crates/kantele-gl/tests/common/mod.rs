@@ -9,7 +9,7 @@ use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::multisample::SampleCount;
 use kantele::scene::Scene;
 use kantele_gl::GlBackend;
-use kantele_io::compare::Comparison;
+use kantele_testkit::compare::Comparison;
 
 /// Largest colour difference (8-bit) allowed away from triangle edges.
 pub const INTERIOR_BOUND: u8 = 3;

@@ -5,7 +5,7 @@
 
 use std::path::Path;
 
-use kantele_io::compare::{compare, edge_mask, Comparison};
+use kantele_testkit::compare::{compare, edge_mask, Comparison};
 
 use crate::common::{
     gl_or_skip, interior_allowance, is_textured_scene, print_comparison, reference_scene_files,
@@ -17,8 +17,8 @@ fn builtin_scenes_agree_with_opengl() {
     let Some(mut gl) = gl_or_skip() else {
         return;
     };
-    for (name, _) in kantele_io::builtin_scenes() {
-        let scene = kantele_io::builtin_scene(name).expect("builtin").scene;
+    for (name, _) in kantele_scene::builtin_scenes() {
+        let scene = kantele_scene::builtin_scene(name).expect("builtin").scene;
         let (a, b, _) = render_both(scene, &mut gl);
         let c = compare(&a, &b, None, 0).expect("same size");
         eprintln!(
@@ -46,7 +46,9 @@ fn mirrored_draws_agree_with_opengl() {
     let Some(mut gl) = gl_or_skip() else {
         return;
     };
-    let mut scene = kantele_io::builtin_scene("teapot").expect("builtin").scene;
+    let mut scene = kantele_scene::builtin_scene("teapot")
+        .expect("builtin")
+        .scene;
     for draw in &mut scene.draws {
         draw.model = glam::Mat4::from_scale(glam::Vec3::new(-1.0, 1.0, 1.0)) * draw.model;
     }
@@ -74,7 +76,7 @@ fn every_reference_scene_agrees_with_opengl() {
     };
     let mut failures = Vec::new();
     for (name, path) in &reference_scene_files(&dir) {
-        let scene = kantele_io::load_scene(path).expect("load").scene;
+        let scene = kantele_scene::load_scene(path).expect("load").scene;
         let (cpu, gl_image, ids) = render_both(scene, &mut gl);
         let edges = edge_mask(&ids);
         let c: Comparison =

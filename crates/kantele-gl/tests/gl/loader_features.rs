@@ -10,7 +10,7 @@ use glam::{Mat4, Vec3, Vec4};
 use kantele::scene::{AlphaMode, Camera, Draw, Material, Mesh, Scene, TextureBinding};
 use kantele::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
 use kantele_gl::GlBackend;
-use kantele_io::compare::{compare, edge_mask};
+use kantele_testkit::compare::{compare, edge_mask};
 
 use crate::common::{gl_or_skip, render_both};
 
@@ -144,7 +144,9 @@ fn blend_order_and_emission_agree_with_opengl() {
         "ClearCoatTest/glTF-Binary/ClearCoatTest.glb",
         "TextureTransformMultiTest/glTF-Binary/TextureTransformMultiTest.glb",
     ] {
-        let mut scene = kantele_io::load_scene(&dir.join(file)).expect("load").scene;
+        let mut scene = kantele_scene::load_scene(&dir.join(file))
+            .expect("load")
+            .scene;
         scene.resolution = (320, 240);
         assert_agree(file.split('/').next().unwrap_or(file), scene, &mut gl);
     }

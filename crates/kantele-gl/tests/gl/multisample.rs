@@ -8,7 +8,7 @@ use std::sync::Arc;
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::multisample::SampleCount;
 use kantele::RenderError;
-use kantele_io::compare::{compare, edge_mask, Comparison};
+use kantele_testkit::compare::{compare, edge_mask, Comparison};
 
 use crate::common::{
     gl_or_skip, interior_allowance, is_textured_scene, print_comparison, reference_scene_files,
@@ -60,8 +60,8 @@ fn builtin_scenes_agree_with_opengl_at_4x() {
     let Some(mut gl) = gl_or_skip() else {
         return;
     };
-    for (name, _) in kantele_io::builtin_scenes() {
-        let scene = kantele_io::builtin_scene(name).expect("builtin").scene;
+    for (name, _) in kantele_scene::builtin_scenes() {
+        let scene = kantele_scene::builtin_scene(name).expect("builtin").scene;
         let (cpu, gl_image, ids) = render_both_at(scene, &mut gl, SampleCount::X4);
         // The cube and the ground are textured (driver LOD choices differ, as at 1×).
         let textured = matches!(*name, "cube" | "ground");
@@ -95,7 +95,7 @@ fn every_reference_scene_agrees_with_opengl_at_4x() {
         return;
     };
     for (name, path) in &reference_scene_files(&dir) {
-        let scene = kantele_io::load_scene(path).expect("load").scene;
+        let scene = kantele_scene::load_scene(path).expect("load").scene;
         let (cpu, gl_image, ids) = render_both_at(scene, &mut gl, SampleCount::X4);
         let textured = is_textured_scene(name);
         check(name, &cpu, &gl_image, &ids, textured);
@@ -107,7 +107,11 @@ fn gl_depth_ids_and_normals_at_4x_equal_its_1x_ones() {
     let Some(mut gl) = gl_or_skip() else {
         return;
     };
-    let scene = Arc::new(kantele_io::builtin_scene("teapot").expect("builtin").scene);
+    let scene = Arc::new(
+        kantele_scene::builtin_scene("teapot")
+            .expect("builtin")
+            .scene,
+    );
     gl.load(scene.clone()).expect("load");
     for pass in [Pass::Color, Pass::Ids, Pass::Normals] {
         let view = FrameView {

@@ -1,0 +1,253 @@
+//! Scene loading for Kantele: glTF 2.0 (`.gltf`, `.glb`) and OBJ/MTL files into a
+//! [`kantele::scene::Scene`], by the rules of the reference scenes, plus built-in demo scenes.
+//!
+//! The rules (draw order, camera, light, extras, materials) are those of
+//! `shared/scenes/README.md`; the glTF loader follows them exactly, the OBJ loader and the
+//! built-in scenes fill the same structure with sensible defaults.
+//!
+//! # Entry points
+//!
+//! - [`load_scene`] loads a file, choosing the format by extension. Malformed input of any kind
+//!   gives a [`LoadError`] that names the file, never a panic.
+//! - [`builtin_scenes`] lists the built-in scenes (`cube`, `teapot`, `ground`, `pixel-edges`),
+//!   generated in code with no asset files, and [`builtin_scene`] builds one by name.
+//! - Each call returns a [`LoadedScene`]: the [`Scene`], ready for any
+//!   [`Backend`](kantele::backend::Backend), and a [`SceneInfo`] with facts and warnings about
+//!   the source.
+//! - [`mesh_util`] holds helpers shared by the loaders (flat normals, strips and fans to lists,
+//!   a framing camera); [`texture_util`] the procedural textures of the built-in scenes.
+//!
+//! ```no_run
+//! use std::sync::Arc;
+//! use kantele::backend::{Backend, FrameView};
+//! use kantele::cpu::{CpuBackend, CpuOptions};
+//!
+//! let loaded = kantele_scene::builtin_scene("cube")?;
+//! let scene = Arc::new(loaded.scene);
+//! let mut cpu = CpuBackend::new(CpuOptions::default())?;
+//! cpu.load(scene.clone())?;
+//! cpu.render(&FrameView::of_scene(&scene))?;
+//! let image = cpu.read_frame()?;
+//! # Ok::<(), Box<dyn std::error::Error>>(())
+//! ```
+#![warn(missing_docs)]
+
+use std::path::{Path, PathBuf};
+
+use kantele::scene::Scene;
+use thiserror::Error;
+
+mod accessor;
+mod budget;
+mod builtin;
+mod ear_clip;
+/// Bodies of the fuzz targets in `fuzz/`, callable from stable tests (not a public API).
+#[doc(hidden)]
+pub mod fuzz_targets;
+mod gltf_loader;
+mod gltf_patch;
+pub mod mesh_util;
+mod meshopt_views;
+mod obj_loader;
+mod obj_text;
+mod obj_wide;
+mod quiet_panic;
+mod read_policy;
+pub mod texture_util;
+mod uri;
+
+pub use mesh_util::flat_normals;
+
+/// A loaded scene with what a user checks before rendering it.
+#[derive(Clone, Debug)]
+pub struct LoadedScene {
+    /// The scene, ready for any backend.
+    pub scene: Scene,
+    /// Facts about the source file.
+    pub info: SceneInfo,
+}
+
+/// Facts about a source file, for `kantele info` and the render sidecar.
+#[derive(Clone, Debug, Default)]
+pub struct SceneInfo {
+    /// Where it came from (file path or `builtin:NAME`).
+    pub source: String,
+    /// Number of nodes in the file.
+    pub node_count: usize,
+    /// Names of the cameras in the file (empty when a framing camera was made up).
+    pub cameras: Vec<String>,
+    /// Whether the scene's camera came from the file.
+    pub camera_from_file: bool,
+    /// Names of the lights in the file.
+    pub lights: Vec<String>,
+    /// Extensions the file uses.
+    pub extensions_used: Vec<String>,
+    /// Problems that did not stop loading (unsupported but harmless features, ...), once each.
+    /// Features the file uses that are not drawn are listed together in one of them.
+    pub warnings: Vec<String>,
+    /// Width and height of each texture of the scene, as its image header declares them
+    /// (also when textures were not decoded).
+    pub texture_sizes: Vec<(u32, u32)>,
+    /// Features the file uses that are ignored (extensions, animations, skins, ...), once each.
+    pub ignored: Vec<String>,
+}
+
+impl SceneInfo {
+    /// Records a warning unless the same text was recorded before.
+    pub(crate) fn warn(&mut self, message: impl Into<String>) {
+        let message = message.into();
+        if !self.warnings.contains(&message) {
+            self.warnings.push(message);
+        }
+    }
+
+    /// Records a feature of the file that is ignored (reported in one warning line).
+    pub(crate) fn ignore(&mut self, feature: impl Into<String>) {
+        let feature = feature.into();
+        if !self.ignored.contains(&feature) {
+            self.ignored.push(feature);
+        }
+    }
+
+    /// Adds the one warning line that names every ignored feature.
+    pub(crate) fn finish(&mut self) {
+        if !self.ignored.is_empty() {
+            let line = format!(
+                "ignored (not drawn or not applied): {}",
+                self.ignored.join(", ")
+            );
+            self.warn(line);
+        }
+    }
+}
+
+/// Why a scene could not be loaded. Every message names the file.
+#[derive(Debug, Error)]
+pub enum LoadError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The I/O error.
+        source: std::io::Error,
+    },
+    /// The file is not valid glTF / OBJ, or uses something that cannot be drawn.
+    #[error("{path}: {message}")]
+    Invalid {
+        /// The file.
+        path: PathBuf,
+        /// What is wrong.
+        message: String,
+    },
+    /// The file extension is not one we read.
+    #[error("{path}: unknown scene format (expected .gltf, .glb or .obj)")]
+    UnknownFormat {
+        /// The file.
+        path: PathBuf,
+    },
+    /// No built-in scene has that name.
+    #[error("no built-in scene named '{0}' (try: {list})", list = builtin_names().join(", "))]
+    UnknownBuiltin(String),
+}
+
+impl LoadError {
+    /// A [`LoadError::Invalid`] for `path`.
+    pub(crate) fn invalid(path: &Path, message: impl Into<String>) -> Self {
+        LoadError::Invalid {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+}
+
+/// Default memory budget of a load: 4 GiB.
+pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
+
+/// What a load may do: its memory budget, where it may read, and whether problems that can be
+/// worked around (a missing texture file) are errors.
+#[derive(Clone, Debug)]
+pub struct LoadOptions {
+    /// Bytes the load may allocate for what the file controls (vertices, indices, texels,
+    /// decoded images and buffers), checked by arithmetic before each allocation; a file that
+    /// needs more is refused with an error. Default [`DEFAULT_MAX_MEMORY`].
+    pub max_memory: u64,
+    /// Folders, besides the scene file's own folder, from which the scene may read files.
+    /// Only regular files are ever read (no devices, FIFOs or folders), after resolving `..`
+    /// and symbolic links.
+    pub allow_read: Vec<PathBuf>,
+    /// Turn recoverable problems (a texture file that is missing or cannot be decoded) into
+    /// errors instead of warnings.
+    pub strict: bool,
+    /// Decode textures (default). Without it, each image's header is read and a placeholder of
+    /// its size stands in for it: for describing a scene without paying for its pixels.
+    pub decode_textures: bool,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        Self {
+            max_memory: DEFAULT_MAX_MEMORY,
+            allow_read: Vec::new(),
+            strict: false,
+            decode_textures: true,
+        }
+    }
+}
+
+/// Loads a scene file with the default [`LoadOptions`], choosing the format by extension
+/// (`.gltf`, `.glb`, `.obj`).
+///
+/// Malformed input of any kind gives an error naming the file; the loader does not panic.
+pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadError> {
+    load_scene_with(path, &LoadOptions::default())
+}
+
+/// Loads a scene file under the given options (memory budget, read policy, strictness).
+///
+/// Malformed input of any kind gives an error naming the file; the loader does not panic and
+/// does not allocate beyond `options.max_memory` for what the file controls.
+pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
+    let extension = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .map(str::to_ascii_lowercase);
+    let loader: fn(&Path, &LoadOptions) -> Result<LoadedScene, LoadError> =
+        match extension.as_deref() {
+            Some("gltf") | Some("glb") => gltf_loader::load,
+            Some("obj") => obj_loader::load,
+            _ => {
+                return Err(LoadError::UnknownFormat {
+                    path: path.to_path_buf(),
+                })
+            }
+        };
+    // The parsing crates are defensive but not panic-free on every malformed input (unchecked
+    // `unreachable!`s, arithmetic on counts); a panic there must become a one-line error, not a
+    // crash or a backtrace on stderr.
+    match quiet_panic::catch(|| loader(path, options)) {
+        Ok(Ok(mut loaded)) => {
+            loaded.info.finish();
+            Ok(loaded)
+        }
+        Ok(Err(e)) => Err(e),
+        Err(what) => Err(LoadError::invalid(
+            path,
+            format!("malformed file (the parser failed: {what})"),
+        )),
+    }
+}
+
+/// Names and one-line descriptions of the built-in scenes.
+pub fn builtin_scenes() -> &'static [(&'static str, &'static str)] {
+    builtin::SCENES
+}
+
+fn builtin_names() -> Vec<&'static str> {
+    builtin_scenes().iter().map(|(n, _)| *n).collect()
+}
+
+/// Builds a built-in scene by name.
+pub fn builtin_scene(name: &str) -> Result<LoadedScene, LoadError> {
+    builtin::build(name).ok_or_else(|| LoadError::UnknownBuiltin(name.to_string()))
+}

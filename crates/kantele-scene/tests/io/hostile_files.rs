@@ -1,0 +1,264 @@
+//! Hostile files (issue 12): resource bombs are refused by arithmetic before anything is
+//! allocated, and a scene reads only regular files inside its own folder unless allowed more.
+//! Big inputs are generated here and run in a child process under `ulimit -v`, so an
+//! allocation that slipped past the budget would abort the child and fail the test.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use crate::common::*;
+use kantele_scene::{load_scene, load_scene_with, LoadOptions};
+use serde_json::json;
+
+/// A triangle whose POSITION accessor is sparse with `count` elements and no buffer view.
+fn sparse_bomb(count: u64) -> Gltf {
+    let mut g = Gltf::new();
+    let indices = g.accessor(&[0, 0, 0, 0], 5125, "SCALAR", 1, false);
+    let values = g.accessor(&[0; 12], 5126, "VEC3", 1, false);
+    let positions = json!({
+        "componentType": 5126, "type": "VEC3", "count": count,
+        "sparse": {"count": 1,
+            "indices": {"bufferView": g.json["accessors"][indices]["bufferView"], "componentType": 5125},
+            "values": {"bufferView": g.json["accessors"][values]["bufferView"]}}
+    });
+    g.json["accessors"].as_array_mut().unwrap().push(positions);
+    let p = g.json["accessors"].as_array().unwrap().len() - 1;
+    let mesh = g.mesh("bomb", vec![json!({"attributes": {"POSITION": p}})]);
+    let node = g.node(json!({"mesh": mesh}));
+    g.root(node);
+    g
+}
+
+/// The PNG header of an image that declares `width` × `height` (the pixel data is tiny and
+/// broken: a loader that trusted the header would allocate first and fail later).
+fn png_header_claiming(width: u32, height: u32) -> Vec<u8> {
+    let mut png = png(1, 1, &[255, 0, 0, 255]);
+    // IHDR: length at 8, type at 12, data at 16..29 (width, height first), CRC at 29..33.
+    png[16..20].copy_from_slice(&width.to_be_bytes());
+    png[20..24].copy_from_slice(&height.to_be_bytes());
+    let crc = crc32(&png[12..29]);
+    png[29..33].copy_from_slice(&crc.to_be_bytes());
+    png
+}
+
+/// CRC-32 (IEEE), as PNG chunks use it.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = 0xffff_ffffu32;
+    for &b in bytes {
+        crc ^= b as u32;
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0xedb8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
+/// Runs this test binary's `child_load` test in a child process with virtual memory capped at
+/// `limit_mib`, loading `path`; returns (exit success, stderr + stdout).
+fn load_in_capped_child(path: &Path, limit_mib: u64) -> (bool, String) {
+    let exe = std::env::current_exe().unwrap();
+    let script = format!(
+        "ulimit -v {} && exec \"$0\" hostile_files::child_load --exact --nocapture --test-threads=1",
+        limit_mib * 1024
+    );
+    let out = Command::new("sh")
+        .arg("-c")
+        .arg(script)
+        .arg(exe)
+        .env("KANTELE_CHILD_LOAD", path)
+        .output()
+        .expect("run the child");
+    let text = format!(
+        "{}{}",
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    (out.status.success(), text)
+}
+
+/// The child side of [`load_in_capped_child`]: loads the file named by `KANTELE_CHILD_LOAD`
+/// and prints the outcome; passes trivially when run as an ordinary test.
+#[test]
+fn child_load() {
+    let Ok(path) = std::env::var("KANTELE_CHILD_LOAD") else {
+        return;
+    };
+    match load_scene(Path::new(&path)) {
+        Ok(_) => println!("CHILD: loaded"),
+        Err(e) => println!("CHILD: error: {e}"),
+    }
+}
+
+#[test]
+fn sparse_accessor_bomb_is_refused_before_allocating() {
+    let dir = temp_dir("sparse-bomb");
+    let path = dir.join("bomb.glb");
+    sparse_bomb(1 << 31).write_glb(&path);
+    let err = load_scene(&path).expect_err("must be refused").to_string();
+    assert!(err.contains("memory budget"), "{err}");
+    assert!(err.contains("bomb.glb"), "{err}");
+    // Under a 1 GiB address-space cap the child must report the error, not abort.
+    let (ok, text) = load_in_capped_child(&path, 1024);
+    assert!(ok, "child failed: {text}");
+    assert!(
+        text.contains("CHILD: error:") && text.contains("memory budget"),
+        "{text}"
+    );
+    // The same file with a count that fits loads, zero-filled with the sparse value on top.
+    let path = dir.join("small.glb");
+    sparse_bomb(3).write_glb(&path);
+    let loaded = load_scene(&path).expect("small sparse accessor");
+    assert_eq!(loaded.scene.meshes[0].positions.len(), 3);
+}
+
+#[test]
+fn huge_declared_image_is_refused_from_its_header() {
+    let dir = temp_dir("image-bomb");
+    let mut g = textured_quad();
+    g.images[0] = png_header_claiming(16000, 16000);
+    let path = dir.join("bomb.glb");
+    g.write_glb(&path);
+    let small = LoadOptions {
+        max_memory: 64 << 20,
+        ..LoadOptions::default()
+    };
+    let err = load_scene_with(&path, &small)
+        .expect_err("must be refused")
+        .to_string();
+    assert!(
+        err.contains("16000x16000") && err.contains("memory budget"),
+        "{err}"
+    );
+    let (ok, text) = load_in_capped_child(&path, 2048);
+    assert!(ok, "child failed: {text}");
+    assert!(text.contains("CHILD: "), "{text}");
+}
+
+#[test]
+fn identical_images_are_decoded_once() {
+    let dir = temp_dir("dedup");
+    let mut g = textured_quad();
+    let second = g.image(test_png());
+    let texture = g.texture(json!({"source": second}));
+    let material =
+        g.material(json!({"pbrMetallicRoughness": {"baseColorTexture": {"index": texture}}}));
+    let p = g.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    let mesh = g.mesh(
+        "second",
+        vec![json!({"attributes": {"POSITION": p}, "material": material})],
+    );
+    let node = g.node(json!({"mesh": mesh}));
+    g.root(node);
+    let path = dir.join("dedup.glb");
+    g.write_glb(&path);
+    let loaded = load_scene(&path).unwrap();
+    assert_eq!(
+        loaded.scene.textures.len(),
+        1,
+        "two identical images, one texture"
+    );
+}
+
+fn write_quad_referring_to(dir: &Path, uri: &str) -> PathBuf {
+    let g = textured_quad();
+    let path = dir.join("quad.gltf");
+    g.write_gltf_external(&path);
+    let mut json: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(&path).unwrap()).unwrap();
+    json["buffers"][0]["uri"] = json!(uri);
+    std::fs::write(&path, serde_json::to_vec(&json).unwrap()).unwrap();
+    path
+}
+
+#[test]
+fn reads_are_confined_to_the_scene_folder() {
+    let base = temp_dir("confined");
+    let scene_dir = base.join("scene");
+    std::fs::create_dir_all(&scene_dir).unwrap();
+    // The buffer moved one folder up: refused unless that folder is allowed.
+    let path = write_quad_referring_to(&scene_dir, "../quad.bin");
+    std::fs::rename(scene_dir.join("quad.bin"), base.join("quad.bin")).unwrap();
+    let err = load_scene(&path).expect_err("outside").to_string();
+    assert!(err.contains("outside the scene's folder"), "{err}");
+    let allowed = LoadOptions {
+        allow_read: vec![base.clone()],
+        ..LoadOptions::default()
+    };
+    load_scene_with(&path, &allowed).expect("allowed folder");
+    // A symbolic link inside the folder that points outside is resolved and refused.
+    std::os::unix::fs::symlink(base.join("quad.bin"), scene_dir.join("link.bin")).unwrap();
+    let path = write_quad_referring_to(&scene_dir, "link.bin");
+    let err = load_scene(&path).expect_err("symlink out").to_string();
+    assert!(err.contains("outside the scene's folder"), "{err}");
+    // Devices and absolute file URIs.
+    let path = write_quad_referring_to(&scene_dir, "file:///dev/zero");
+    let err = load_scene(&path).expect_err("device").to_string();
+    assert!(err.contains("outside"), "{err}");
+    let everything = LoadOptions {
+        allow_read: vec![PathBuf::from("/dev")],
+        ..LoadOptions::default()
+    };
+    let err = load_scene_with(&path, &everything)
+        .expect_err("device")
+        .to_string();
+    assert!(err.contains("not a regular file"), "{err}");
+    // A FIFO inside the folder is never opened (opening it would hang).
+    let fifo = scene_dir.join("fifo.bin");
+    let made = Command::new("mkfifo").arg(&fifo).status();
+    if made.is_ok_and(|s| s.success()) {
+        let path = write_quad_referring_to(&scene_dir, "fifo.bin");
+        let err = load_scene(&path).expect_err("fifo").to_string();
+        assert!(err.contains("not a regular file"), "{err}");
+    }
+    // A folder.
+    std::fs::create_dir_all(scene_dir.join("folder.bin")).unwrap();
+    let path = write_quad_referring_to(&scene_dir, "folder.bin");
+    let err = load_scene(&path).expect_err("folder").to_string();
+    assert!(err.contains("not a regular file"), "{err}");
+}
+
+#[test]
+fn obj_texture_reads_are_confined_too() {
+    let base = temp_dir("confined-obj");
+    let scene_dir = base.join("scene");
+    std::fs::create_dir_all(&scene_dir).unwrap();
+    std::fs::write(base.join("private.png"), test_png()).unwrap();
+    let path = scene_dir.join("tex.obj");
+    std::fs::write(
+        &path,
+        "mtllib tex.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nusemtl m\nf 1/1 2/1 3/1\n",
+    )
+    .unwrap();
+    std::fs::write(
+        scene_dir.join("tex.mtl"),
+        "newmtl m\nmap_Kd ../private.png\n",
+    )
+    .unwrap();
+    let loaded = load_scene(&path).expect("loads untextured");
+    assert!(loaded.scene.textures.is_empty());
+    assert!(
+        loaded
+            .info
+            .warnings
+            .iter()
+            .any(|w| w.contains("outside the scene's folder")),
+        "{:?}",
+        loaded.info.warnings
+    );
+    let allowed = LoadOptions {
+        allow_read: vec![base.clone()],
+        ..LoadOptions::default()
+    };
+    assert_eq!(
+        load_scene_with(&path, &allowed)
+            .unwrap()
+            .scene
+            .textures
+            .len(),
+        1
+    );
+}

@@ -1,0 +1,20 @@
+//! Integration tests of `kantele-scene`: glTF and OBJ loading (valid, bad and hostile files, the
+//! real-world corpus), fuzz replay, poses, the reference scenes and ISA-identical pictures.
+//!
+//! One test binary with a module per subject: a binary per file would compile the shared
+//! generic code and link every dependency into each (in a clean build, 31 test binaries took a
+//! quarter of CI's compile time).
+
+#[path = "../common/mod.rs"]
+mod common;
+
+mod bad_input;
+mod corpus;
+mod fuzz_replay;
+mod gltf_files;
+mod hostile_files;
+mod isa_identical;
+mod obj_files;
+mod reference_scenes;
+mod srgb8_target;
+mod valid_files;

@@ -1,6 +1,0 @@
-//! Shading resources: textures, their 8-bit texel format and the samplers that read them.
-mod levels;
-pub(crate) mod sample_lanes;
-pub mod texel;
-mod texel_lanes;
-pub mod texture;
