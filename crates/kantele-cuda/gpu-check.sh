@@ -1,12 +1,20 @@
 #!/usr/bin/env bash
-# The CUDA backend's check on a GPU machine, prepared on a machine without one.
+# The CUDA backend's check, for a machine with an NVIDIA GPU (CI has none): run it after changing
+# the kernels.
 #
-#   crates/kantele-cuda/gpu-check.sh build      # here: release binary with --features cuda,
-#                                               # stripped, plus the reference scenes, in
-#                                               # target/gpu-check/ (about 30 MB)
-#   crates/kantele-cuda/gpu-check.sh run        # there (the device tool, carry target/gpu-check):
-#                                               # every check below, logs in $OUT (or
-#                                               # target/gpu-check/out)
+#   crates/kantele-cuda/gpu-check.sh build [DIR]
+#       builds the release binary with --features cuda and puts it, stripped, into DIR (default
+#       target/gpu-check) with the reference scenes and this script (about 30 MB), for a GPU
+#       machine without a Rust toolchain: copy DIR there and run DIR/gpu-check.sh run.
+#   crates/kantele-cuda/gpu-check.sh run [KANTELE [OUT]]
+#       every check below. KANTELE: the kantele binary built with --features cuda (default
+#       $KANTELE, else the kantele beside this script, else target/gpu-check/kantele, else
+#       target/release/kantele); OUT: the folder for logs, pictures and summary.txt (default
+#       $OUT, else gpu-check-out in the current folder).
+#
+# The reference scenes are $KANTELE_SHARED/scenes (KANTELE_SHARED defaults to ../shared beside
+# the checkout; see docs/rendering-rules.md, "Reference scenes"); without KANTELE_SHARED, `run`
+# takes the scenes/ folder beside the binary when there is one (as `build` lays it out).
 #
 # What `run` checks, each step logged to its own file and summarised in summary.txt:
 #  1. the device, the driver and where NVRTC comes from (KANTELE_NVRTC, else the CUDA toolkit,
@@ -18,24 +26,37 @@
 #  4. compute-sanitizer memcheck and racecheck on one render (it refuses the GPU on some
 #     machines: that is logged, not hidden);
 #  5. `kantele bench` of every scene with cpu, cuda, cuda-ocot, cuda-ocmt and gl;
-#  6. the CPU backend's thread scaling (issue 7): every scene at 1, 2, 4, 8 and 16 threads
-#     (`--json`, one file per count: scaling-N.json), with the 16 / 1 ratios in scaling.log.
+#  6. the CPU backend's thread scaling: every scene at 1, 2, 4, 8 and 16 threads (`--json`, one
+#     file per count: scaling-N.json), with the 16 / 1 ratios in scaling.log.
 # The script goes on after a failing step and exits non-zero if any step failed.
 set -uo pipefail
-here="$(cd "$(dirname "$0")/../.." && pwd)"
-bundle="$here/target/gpu-check"
+self="$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)"
+root="$(cd "$self/../.." && pwd)"
+
+# The reference scenes' folder for `build`: $KANTELE_SHARED/scenes, else ../shared/scenes.
+shared_scenes() {
+  echo "${KANTELE_SHARED:-$root/../shared}/scenes"
+}
 
 build() {
   set -e
-  cd "$here"
-  cargo build --release --locked -p kantele-cli --features cuda
+  local bundle="${1:-$root/target/gpu-check}"
+  local scenes
+  scenes="$(shared_scenes)"
+  if ! ls "$scenes"/*.glb >/dev/null 2>&1; then
+    echo "error: no reference scenes in $scenes (set KANTELE_SHARED)" >&2
+    exit 2
+  fi
+  scenes="$(cd "$scenes" && pwd)"
   mkdir -p "$bundle/scenes"
+  bundle="$(cd "$bundle" && pwd)"
+  cd "$root"
+  cargo build --release --locked -p kantele-cli --features cuda
   strip -o "$bundle/kantele" target/release/kantele
-  local scenes="${KANTELE_SCENES:-$here/../shared/scenes}"
-  [ -d "$scenes" ] || scenes=/work/shared/scenes
   cp "$scenes"/*.glb "$bundle/scenes/"
+  cp "$self/gpu-check.sh" "$bundle/gpu-check.sh"
   du -sh "$bundle"
-  echo "bundle ready: carry target/gpu-check and run: crates/kantele-cuda/gpu-check.sh run"
+  echo "ready: copy $bundle to the GPU machine and run: $bundle/gpu-check.sh run"
 }
 
 find_nvrtc() {
@@ -53,9 +74,29 @@ find_nvrtc() {
 }
 
 run() {
-  local out="${OUT:-$bundle/out}"
+  local k="${1:-${KANTELE:-}}" out="${2:-${OUT:-gpu-check-out}}" scenes failed=0
+  if [ -z "$k" ]; then
+    for k in "$self/kantele" "$root/target/gpu-check/kantele" "$root/target/release/kantele"; do
+      [ -x "$k" ] && break
+    done
+  fi
+  if [ ! -x "$k" ]; then
+    echo "error: no kantele binary at $k (give it: $0 run KANTELE [OUT])" >&2
+    return 2
+  fi
+  if [ -n "${KANTELE_SHARED:-}" ]; then
+    scenes="$KANTELE_SHARED/scenes"
+  elif [ -d "$(dirname "$k")/scenes" ]; then
+    scenes="$(dirname "$k")/scenes"
+  else
+    scenes="$(shared_scenes)"
+  fi
+  if ! ls "$scenes"/*.glb >/dev/null 2>&1; then
+    echo "error: no reference scenes in $scenes (set KANTELE_SHARED)" >&2
+    return 2
+  fi
   mkdir -p "$out"
-  local k="$bundle/kantele" scenes="$bundle/scenes" failed=0
+  out="$(cd "$out" && pwd)"
   local summary="$out/summary.txt"
   : >"$summary"
   step() { # name, command...
@@ -167,8 +208,10 @@ PY
   return $failed
 }
 
-case "${1:-}" in
-  build) build ;;
-  run) run ;;
-  *) echo "usage: $0 build|run" >&2; exit 2 ;;
+cmd="${1:-}"
+[ $# -gt 0 ] && shift
+case "$cmd" in
+  build) build "$@" ;;
+  run) run "$@" ;;
+  *) echo "usage: $0 build [DIR] | run [KANTELE [OUT]]" >&2; exit 2 ;;
 esac

@@ -24,10 +24,17 @@ def skip_or_fail(name: str, reason: str):
     pytest.skip(reason)
 
 
+def shared_root() -> Path:
+    """The shared test data (`scenes/`, `realworld/`): `KANTELE_SHARED` when it is set and not
+    empty, else `../shared` beside the repository (docs/rendering-rules.md, "Reference scenes");
+    the same folder as `kantele_testkit::shared_root` in the Rust tests."""
+    return Path(os.environ.get("KANTELE_SHARED") or REPO.parent / "shared")
+
+
 @pytest.fixture(scope="session")
 def scenes_dir() -> Path:
-    """`../shared/scenes` beside the repository (or `KANTELE_SCENES`)."""
-    d = Path(os.environ.get("KANTELE_SCENES", REPO.parent / "shared" / "scenes"))
+    """The reference scenes, `$KANTELE_SHARED/scenes`."""
+    d = shared_root() / "scenes"
     if not d.is_dir():
         skip_or_fail("scenes", f"{d} is absent")
     return d

@@ -8,7 +8,7 @@ use kantele::raster::Strategy;
 use kantele::rop::TargetFormat;
 
 /// Kantele: a software rasterizer. Render, inspect, benchmark, compare and view glTF 2.0 / OBJ
-/// scenes by the rules of the reference scenes (`shared/scenes/README.md`).
+/// scenes by Kantele's rendering rules (`docs/rendering-rules.md`).
 ///
 /// Errors are reported as one line `kantele: error: <file>: <problem>` on stderr with exit
 /// status 2 (`compare` exits with 1 when a tolerance is broken).
@@ -454,7 +454,7 @@ pub struct BenchArgs {
 
 const BENCH_HELP: &str = "\
 Each frame is one render() call: clear, every draw, and waiting until the image is complete
-(the timing rules of shared/scenes/README.md). Loading is not timed. The GL backend renders
+(the timing rules of docs/rendering-rules.md). Loading is not timed. The GL backend renders
 into an RGBA8 target here (the fair configuration).
 
 The ratio column (with several backends) is this backend's median time divided by the first

@@ -1,6 +1,6 @@
-//! The OpenGL reference backend of Kantele ("the yardstick"): renders a [`Scene`] by the rules of
-//! the reference scenes (`/work/shared/scenes/README.md`) with a desktop OpenGL 3.3 core context
-//! created headlessly through EGL, so that Kantele's pictures and timings can be compared with a
+//! The OpenGL reference backend of Kantele ("the yardstick"): renders a [`Scene`] by Kantele's
+//! rendering rules (`docs/rendering-rules.md`) with a desktop OpenGL 3.3 core context created
+//! headlessly through EGL, so that Kantele's pictures and timings can be compared with a
 //! real GL driver (Mesa's llvmpipe on CI, a GPU driver where there is one).
 //!
 //! The entry point is [`GlBackend`]: [`GlBackend::new`] creates the context (or returns an
@@ -29,7 +29,7 @@
 //!   row 0 is image row 0 and `glReadPixels` returns the top row first without any copy-flip.
 //!   The flip mirrors the winding, so `glFrontFace(GL_CW)` keeps counter-clockwise-in-NDC
 //!   triangles front-facing (and `gl_FrontFacing` keeps its meaning). Rendered this way, llvmpipe
-//!   and NVIDIA apply the top-left tie rule of the README in image coordinates.
+//!   and NVIDIA apply the rules' top-left tie rule in image coordinates.
 //! - **Colour target.** `GL_RGBA32F` by default: linear float values, encoded to sRGB exactly on
 //!   the host when written as 8-bit. [`GlBackend::set_fast_target`] switches to `GL_RGBA8` (no
 //!   sRGB encoding by the driver), the fair configuration for *timings* (8-bit stores, as a real

@@ -1,5 +1,5 @@
-//! GLSL 3.30 core sources: the reference-scene shading rules (see `/work/shared/scenes/README.md`,
-//! "Shading") written as one vertex and one fragment shader.
+//! GLSL 3.30 core sources: Kantele's shading rules (`docs/rendering-rules.md`, "Shading: the
+//! Lambert model") written as one vertex and one fragment shader.
 
 /// Vertex attribute locations (interleaved buffer, see [`crate::resources`]).
 pub(crate) const VERTEX: &str = r#"#version 330 core

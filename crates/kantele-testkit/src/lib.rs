@@ -1,12 +1,14 @@
 //! Test support shared by Kantele's crates.
 //!
-//! A test that cannot run here (no OpenGL driver, no display, no `../shared` data) says why and
+//! A test that cannot run here (no OpenGL driver, no display, no shared test data) says why and
 //! skips — unless the environment variable `KANTELE_REQUIRE` (a comma-separated list such as
 //! `gl,display,scenes`) names what it lacks: then it fails, so a CI machine that is meant to have
 //! the thing can never pass by skipping. `.ci/run` sets `KANTELE_REQUIRE` for what CI installs.
 //!
 //! [`compare`] measures how two renderings of one frame differ (coverage, colour, depth, a
 //! difference image): `kantele compare` and the OpenGL agreement tests use it.
+//!
+//! The shared test data is found through `KANTELE_SHARED` ([`shared_root`]).
 //!
 //! [`demo`] holds the seed documents' two scenes written against the pipeline API, which the
 //! core's reference-image and band tests and its `seeds` example render.
@@ -37,13 +39,19 @@ pub fn skip(what: &str, reason: impl Display) {
     eprintln!("skipping: {reason}");
 }
 
-/// The repository's `shared/` folder: `../shared` beside the checkout.
+/// The folder of the test data that is not in the repository (`scenes/`, `realworld/`; see
+/// `docs/rendering-rules.md`, "Reference scenes"): `$KANTELE_SHARED` when it is set and not
+/// empty (give an absolute path: tests run in their crate's folder), else `../shared` beside the
+/// checkout.
 pub fn shared_root() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared")
+    match std::env::var_os("KANTELE_SHARED") {
+        Some(dir) if !dir.is_empty() => PathBuf::from(dir),
+        _ => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared"),
+    }
 }
 
-/// `shared/<name>` (`scenes`, `realworld`) when it exists; otherwise [`skip`]s for `name` and
-/// returns `None`.
+/// `<shared_root>/<name>` (`scenes`, `realworld`) when it exists; otherwise [`skip`]s for
+/// `name` and returns `None`.
 #[track_caller]
 pub fn shared_dir(name: &str) -> Option<PathBuf> {
     let dir = shared_root().join(name);

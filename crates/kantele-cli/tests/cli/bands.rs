@@ -1,4 +1,4 @@
-//! Pictures in horizontal bands (issue 12): a picture rendered in bands within a small frame
+//! Pictures in horizontal bands: a picture rendered in bands within a small frame
 //! memory budget is byte for byte the unbanded picture (every output format that streams), a
 //! big picture fits a virtual-memory cap, and an interrupt stops a big frame at once.
 
@@ -179,7 +179,7 @@ fn a_4096_picture_renders_in_a_quarter_gigabyte() {
 
 #[cfg(unix)]
 #[test]
-#[ignore = "16384x16384 takes 27-41 s on the shared 2-core development VM (peak RSS 0.74 GiB); BENCHMARKS.md records it; run with --ignored"]
+#[ignore = "16384x16384 takes 27-41 s on a 2-core virtual machine (peak RSS 0.74 GiB); BENCHMARKS.md records it; run with --ignored"]
 fn the_documented_maximum_renders_within_4_gigabytes() {
     let dir = TempDir::new("bands-16k");
     let (out, elapsed) = capped_render(&dir, "16384x16384", "1G", 4096);

@@ -3,8 +3,8 @@
 //! (in a clean build, 31 test binaries took a quarter of CI's compile time).
 //!
 //! Tests that need the real renderer and loaders (built-in scenes, shared scenes) are written
-//! against the expected behaviour. Tests reading `shared/scenes` skip with a message when the
-//! directory is absent; the viewer test skips when `xvfb-run` is not on PATH.
+//! against the expected behaviour. Tests reading `$KANTELE_SHARED/scenes` skip with a message
+//! when the directory is absent; the viewer test skips when `xvfb-run` is not on PATH.
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};

@@ -1,5 +1,5 @@
-//! Every reference scene of `../shared/scenes`, by property, and reference files patched to be
-//! broken.
+//! Every reference scene of `$KANTELE_SHARED/scenes`, by property, and reference files patched
+//! to be broken.
 
 use crate::common::{kantele, ok, stderr, TempDir};
 use crate::{assert_clean_failure, read_pfm, shared_scenes};
@@ -10,8 +10,8 @@ fn luminance(p: &image::Rgba<u8>) -> f32 {
     0.2126 * lin(p.0[0]) + 0.7152 * lin(p.0[1]) + 0.0722 * lin(p.0[2])
 }
 
-/// Renders every `.glb` in `../shared/scenes` in one run of the binary and checks each image's
-/// size against INDEX.md, then properties that a wrong renderer would break.
+/// Renders every `.glb` in `$KANTELE_SHARED/scenes` in one run of the binary and checks each
+/// image's size against INDEX.md, then properties that a wrong renderer would break.
 #[test]
 fn every_shared_scene_renders_and_looks_right() {
     let Some(scenes) = shared_scenes() else {

@@ -1,9 +1,9 @@
-//! Peak memory of `render` on a file with many large textures (issue 9): ten textures, each
+//! Peak memory of `render` on a file with many large textures: ten textures, each
 //! stored as 8-bit RGBA with its mip chain, must render within a memory cap that scales with
 //! the texel count. The file is generated here (never committed): ten `SIZE²` PNG files and a
 //! `.gltf` with ten textured quads. The binary runs under `ulimit -v`.
 //!
-//! `KANTELE_TEXTURE_MEMORY_SIZE=4096` makes the issue's file (ten 4096² textures), and
+//! `KANTELE_TEXTURE_MEMORY_SIZE=4096` makes the full-size file (ten 4096² textures), and
 //! `KANTELE_TEXTURE_MEMORY_DIR=FOLDER` writes it there and keeps it, for a manual measurement
 //! (`BENCHMARKS.md`); the default, 1024² in a temporary folder, keeps the test to seconds.
 
@@ -107,7 +107,7 @@ fn many_large_textures_render_within_a_scaled_memory_cap() {
         std::fs::create_dir_all(keep).expect("create KANTELE_TEXTURE_MEMORY_DIR");
     }
     let scene = write_scene(keep.as_deref().unwrap_or(&dir.0), size);
-    // The issue's bound, 2 GiB for ten 4096² textures, scaled by the texel count, plus a fixed
+    // The bound, 2 GiB for ten 4096² textures, scaled by the texel count, plus a fixed
     // allowance for the process itself (code, two worker stacks, allocator arenas: address
     // space, which `ulimit -v` counts, not resident memory; measured: the 1024² file renders
     // under 300 MiB and not under 200). Textures stored as f32 instead of 8-bit would fail it.

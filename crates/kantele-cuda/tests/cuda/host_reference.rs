@@ -3,7 +3,7 @@
 //! wrap mode and filter) compiled as host C++ and compared bit for bit with the Rust core on
 //! thousands of random inputs. Every `_rn` CUDA intrinsic the kernels use is a correctly
 //! rounded IEEE operation, as x86-64's SSE arithmetic is, so agreement here means the GPU
-//! computes the CPU's coverage and depth (what is left for the GPU machine: the compiler and the
+//! computes the CPU's coverage and depth (what is left for a run on a GPU: the compiler and the
 //! hardware keeping that promise — `gpu-check.sh`).
 //!
 //! Needs a C++ compiler (`$CXX`, else `c++`); skips without one unless `KANTELE_REQUIRE` names
@@ -430,8 +430,8 @@ fn kernel_matrices_and_vertex_transform_match_glam() {
 
 /// Texture sampling: the kernels filter linear `f32` texels decoded at upload from the core's
 /// RGBA8 levels, the core's scalar sampler decodes as it fetches; the two may round the last
-/// bit differently (issue 8 allows texture filtering to round differently), so each channel must
-/// agree within 4e-6 — far below one 8-bit level (3.9e-3).
+/// bit differently (bit identity is promised for coverage and depth, not for texture
+/// filtering), so each channel must agree within 4e-6 — far below one 8-bit level (3.9e-3).
 #[test]
 fn kernel_texture_sampling_matches_the_core() {
     let Some(harness) = build_harness() else {

@@ -89,7 +89,7 @@ pub fn is_textured_scene(name: &str) -> bool {
 }
 
 /// Interior pixels allowed over [`INTERIOR_BOUND`]: texture level-of-detail choices differ
-/// between drivers (the scenes' README measures up to 0.6% of pixels between llvmpipe and
+/// between drivers (`docs/rendering-rules.md` gives up to 0.6% of pixels between llvmpipe and
 /// NVIDIA); untextured scenes must agree everywhere but on edges.
 pub fn interior_allowance(pixels: usize, textured: bool) -> usize {
     if textured {

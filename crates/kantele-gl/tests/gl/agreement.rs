@@ -1,7 +1,8 @@
-//! Kantele against OpenGL on every reference scene in `../shared/scenes`: the yardstick.
+//! Kantele against OpenGL on every reference scene in `$KANTELE_SHARED/scenes`: the yardstick.
 //!
-//! Both render the same `Scene` by the same rules into float targets; the pictures are compared
-//! as 8-bit sRGB. Skips (with a message) when EGL/OpenGL or the scenes are unavailable.
+//! Both render the same `Scene` by the same rules (`docs/rendering-rules.md`) into float
+//! targets; the pictures are compared as 8-bit sRGB. Skips (with a message) when EGL/OpenGL or
+//! the scenes are unavailable.
 
 use std::path::Path;
 

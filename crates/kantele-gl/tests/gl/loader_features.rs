@@ -1,9 +1,8 @@
 //! The scene features the loaders added (BLEND draw order, emissive colour and texture) drawn by
 //! Kantele and by OpenGL: the pictures must agree as on the reference scenes. Also the shared
-//! real-world samples that exercise them, when present (`KANTELE_SHARED` or `../shared`).
+//! real-world samples that exercise them, when present (`$KANTELE_SHARED/realworld`).
 //! Skips (with a message) where EGL/OpenGL is unavailable.
 
-use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Mat4, Vec3, Vec4};
@@ -128,17 +127,9 @@ fn blend_order_and_emission_agree_with_opengl() {
     assert_agree("blend-order+emissive", scene, &mut gl);
 
     // The real samples that exercise these features.
-    let shared = std::env::var_os("KANTELE_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    let dir = shared.join("realworld");
-    if !dir.is_dir() {
-        eprintln!(
-            "skipping the real-world samples: {} is absent",
-            dir.display()
-        );
+    let Some(dir) = kantele_testkit::shared_dir("realworld") else {
         return;
-    }
+    };
     for file in [
         "AlphaBlendModeTest/glTF-Binary/AlphaBlendModeTest.glb",
         "ClearCoatTest/glTF-Binary/ClearCoatTest.glb",

@@ -1,10 +1,10 @@
-//! Issue 12's "clipping a 1e6 ground plane at the near plane loses 10% of pixels against
-//! OpenGL": a 1e6-sized quad (two triangles) seen from a few units above it, looking at the
-//! horizon, over a sweep of heights, pitches, near and far planes and plane sizes, against the
-//! exact picture (ray casting in f64) and against OpenGL.
+//! Does clipping a 1e6 ground plane at the near plane lose pixels against OpenGL? A 1e6-sized
+//! quad (two triangles) seen from a few units above it, looking at the horizon, over a sweep of
+//! heights, pitches, near and far planes and plane sizes, against the exact picture (ray casting
+//! in f64) and against OpenGL.
 //!
-//! Found (2026-12, Mesa llvmpipe): up to `extent / near = 1e7` (the issue's 1e6 plane with a
-//! 0.1 near plane) Kantele's picture is exact but for one row on the near-plane cut, while
+//! Measured against Mesa llvmpipe: up to `extent / near = 1e7` (a 1e6 plane with a 0.1 near
+//! plane) Kantele's picture is exact but for one row on the near-plane cut, while
 //! OpenGL loses up to 8% of the ground. From 1e8 on both lose most or all of it, differently:
 //! the far corners' f32 clip coordinates (errors ≈ extent·2^-24) no longer say where the cut at
 //! `w = near` lies, so no clipper fed f32 clip positions can recover it.

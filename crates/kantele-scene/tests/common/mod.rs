@@ -19,14 +19,14 @@ pub fn temp_dir(name: &str) -> PathBuf {
     dir
 }
 
-/// The reference scenes, when this checkout has them next to it (a failure instead of a skip
+/// The reference scenes (`$KANTELE_SHARED/scenes`), when present (a failure instead of a skip
 /// when `KANTELE_REQUIRE` names `scenes`).
 pub fn reference_scenes() -> Option<PathBuf> {
     kantele_testkit::shared_dir("scenes")
 }
 
-/// The reference scenes' `.glb` files, sorted (at least the 18 of `../shared/scenes`), when
-/// this checkout has them (see [`reference_scenes`]).
+/// The reference scenes' `.glb` files, sorted (at least the 18 of
+/// `docs/rendering-rules.md`), when present (see [`reference_scenes`]).
 pub fn reference_scene_files() -> Option<Vec<PathBuf>> {
     let dir = reference_scenes()?;
     let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)

@@ -1,10 +1,10 @@
-//! The corpus (issue 9): small files written here, one per feature, and the real sample files
-//! of `../shared/realworld`, each loaded and rendered with the CPU backend at a small size and
+//! The corpus: small files written here, one per feature, and the real sample files of
+//! `$KANTELE_SHARED/realworld`, each loaded and rendered with the CPU backend at a small size and
 //! checked by a property the picture must show.
 //!
-//! The real files are read from the shared folder (never copied into the repository). When it
-//! is absent the test says so and skips them, unless `KANTELE_REQUIRE` contains `scenes`,
-//! where it fails. The shared folder is `../shared` beside the checkout, or `KANTELE_SHARED`.
+//! The real files are read from the shared test data (never copied into the repository; see
+//! `docs/rendering-rules.md`, "Reference scenes"). When they are absent the test says so and
+//! skips them, unless `KANTELE_REQUIRE` contains `realworld`, where it fails.
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -341,28 +341,10 @@ fn concave_obj_face_keeps_its_notch() {
     assert!((ratio - 0.75).abs() < 0.02, "L / square = {ratio}");
 }
 
-/// The shared real-world folder, or `None` (with a printed reason) when it is absent; absent
-/// and required (`KANTELE_REQUIRE` contains `scenes`) fails.
+/// The real-world samples (`$KANTELE_SHARED/realworld`), or `None` (with a printed reason)
+/// when they are absent; absent and required (`KANTELE_REQUIRE` contains `realworld`) fails.
 fn realworld() -> Option<PathBuf> {
-    // `KANTELE_SHARED` names the shared folder when it is not beside the checkout.
-    let shared = std::env::var_os("KANTELE_SHARED")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| Path::new(env!("CARGO_MANIFEST_DIR")).join("../../../shared"));
-    let dir = shared.join("realworld");
-    if dir.is_dir() {
-        return Some(dir);
-    }
-    let required = std::env::var("KANTELE_REQUIRE").is_ok_and(|r| r.contains("scenes"));
-    assert!(
-        !required,
-        "KANTELE_REQUIRE names scenes but {} is absent",
-        dir.display()
-    );
-    eprintln!(
-        "skipping the real-world corpus: {} is absent",
-        dir.display()
-    );
-    None
+    kantele_testkit::shared_dir("realworld")
 }
 
 /// Share of pixels covered in the colour pass.

@@ -1,4 +1,4 @@
-//! Hostile files (issue 12): resource bombs are refused by arithmetic before anything is
+//! Hostile files: resource bombs are refused by arithmetic before anything is
 //! allocated, and a scene reads only regular files inside its own folder unless allowed more.
 //! Big inputs are generated here and run in a child process under `ulimit -v`, so an
 //! allocation that slipped past the budget would abort the child and fail the test.

@@ -113,7 +113,7 @@ fn obj_without_mtl_uses_the_default_material() {
     assert!(mesh.normals.as_ref().unwrap().iter().all(|n| *n == Vec3::Z));
 }
 
-/// Real-world OBJ details (issue 9): texture paths relative to the MTL's folder, one-value
+/// Real-world OBJ details: texture paths relative to the MTL's folder, one-value
 /// colours, Latin-1 names, empty material names, concave faces, `l` lines (kept as line meshes), malformed MTL lines.
 #[test]
 fn real_world_obj_details() {

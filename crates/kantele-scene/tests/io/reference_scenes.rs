@@ -1,4 +1,4 @@
-//! Every reference scene of `shared/scenes` loads with the counts of its INDEX.md.
+//! Every reference scene of `$KANTELE_SHARED/scenes` loads with the counts of its INDEX.md.
 // Quaternions are copied digit for digit from the files.
 #![allow(clippy::excessive_precision)]
 
