@@ -490,7 +490,7 @@ impl Mask8 for Avx2Mask {
     }
 }
 
-// --- TexelGather: the texture sampler's lane operations (issue 7, `tex` round) ---
+// --- TexelGather: the texture sampler's lane operations ---
 
 impl super::TexelGather for Avx2I32 {
     #[inline(always)]
@@ -650,7 +650,7 @@ fn packed_weights15(weight: __m256i) -> [__m256i; 2] {
 /// compiler extracts them from the register instead (`vmovd`, `vextracti128`, six `vpextrd`:
 /// 15 µops, most of them on the shuffle port that the filter's unpacks and the sampler's
 /// permutes also need); [`std::hint::black_box`] keeps the array in memory. It changes no value
-/// and no instruction count. Measured (issue 7, nineteenth session, `avx512`, two threads,
+/// and no instruction count. Measured (`avx512`, two threads,
 /// 6 alternating rounds of every scene): cube-textured −8.6%, `paper-c2` −9.9%, `c4` −6.4%,
 /// spot −3.9%, near-clip −3.7%.
 #[inline(always)]

@@ -89,7 +89,7 @@ mod scalar;
 mod sse2;
 #[cfg(test)]
 mod tests;
-// The texture sampler's lane operations (issue 7, `tex` round).
+// The texture sampler's lane operations.
 mod texel_gather;
 
 #[cfg(target_arch = "x86_64")]

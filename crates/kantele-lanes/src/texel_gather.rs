@@ -1,4 +1,4 @@
-//! Lane operations of the texture sampler (issue 7, `tex` round): fetching two neighbouring
+//! Lane operations of the texture sampler: fetching two neighbouring
 //! texels per lane at once, and decoding the red, green and blue bytes of packed texels through
 //! a 256-entry table.
 //!

@@ -137,7 +137,7 @@ mod tests {
     fn panic_locations_are_told_apart() {
         assert!(is_kantele_source("crates/kantele-scene/src/accessor.rs"));
         assert!(is_kantele_source(
-            "/work/kantele/crates/kantele/src/setup.rs"
+            "/src/kantele/crates/kantele-rules/src/setup.rs"
         ));
         assert!(!is_kantele_source(
             "/root/.cargo/registry/src/index.crates.io-1/gltf-json-1.4.1/src/path.rs"

@@ -2,7 +2,7 @@
 //! [`kantele::scene::Scene`], by the rules of the reference scenes, plus built-in demo scenes.
 //!
 //! The rules (draw order, camera, light, extras, materials) are those of
-//! `shared/scenes/README.md`; the glTF loader follows them exactly, the OBJ loader and the
+//! `docs/rendering-rules.md`; the glTF loader follows them exactly, the OBJ loader and the
 //! built-in scenes fill the same structure with sensible defaults.
 //!
 //! # Entry points

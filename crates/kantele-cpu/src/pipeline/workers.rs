@@ -2,13 +2,13 @@
 //!
 //! Pinning is opt-in ([`RendererOptions::pin_workers`](super::RendererOptions::pin_workers),
 //! or [`PIN_ENV`]`=1`). It helps where the operating system keeps workers on fewer CPUs than
-//! it has: on the 2-core test VM, whose kernel packs threads onto fewer virtual CPUs, both
+//! it has: on a 2-vCPU virtual machine whose kernel packs threads onto fewer virtual CPUs, both
 //! workers at times shared one CPU for whole runs, the keep-awake loops ([`super::warm`])
 //! handed it back and forth, and a frame took the one-thread time (a full-screen triangle at
 //! 2048 × 1536: 0.53 ms instead of 0.29 in 14 of 16 runs; pinned, 0.29 ms in 16 of 16). It
 //! costs where other busy threads share the machine: a pinned worker cannot leave a CPU that
 //! another process holds, so with one CPU-bound process beside it bunny took 12–16 ms pinned
-//! against 10.5–11.3 ms free (BENCHMARKS.md, twenty-second session). Pinning changes only
+//! against 10.5–11.3 ms free (docs/design-notes.md, threading). Pinning changes only
 //! where threads run, never what is computed.
 
 use core_affinity::CoreId;
