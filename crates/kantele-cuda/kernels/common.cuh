@@ -10,7 +10,8 @@
 
 #if !defined(KANTELE_SUBPIXEL_BITS) || !defined(KANTELE_TILE_LOG2) ||                       \
     !defined(KANTELE_GUARD_BAND_PIXELS) || !defined(KANTELE_SUBPIXEL_LIMIT) ||              \
-    !defined(KANTELE_W_EPSILON) || !defined(KANTELE_MAX_CLIPPED_VERTICES) ||                \
+    !defined(KANTELE_W_EPSILON) || !defined(KANTELE_W_RELATIVE_EPSILON) ||                  \
+    !defined(KANTELE_MAX_CLIPPED_VERTICES) ||                                                \
     !defined(KANTELE_VARYINGS) || !defined(KANTELE_TRIANGLE_SETUP_SIZE) ||                  \
     !defined(KANTELE_DRAW_RECORD_SIZE) || !defined(KANTELE_BIN_CHUNK) ||                    \
     !defined(KANTELE_SMALL_BOX_PIXELS)
@@ -317,8 +318,8 @@ __device__ __forceinline__ double kd_add(double a, double b) { return __dadd_rn(
 __device__ __forceinline__ double kd_sub(double a, double b) { return __dsub_rn(a, b); }
 __device__ __forceinline__ double kd_div(double a, double b) { return __ddiv_rn(a, b); }
 
-// The polygon's `w` plane lies at 2^-40 · (largest w), or KANTELE_W_EPSILON (`W_MIN`) if larger.
-#define KANTELE_W_RELATIVE_EPSILON (1.0 / 1099511627776.0)
+// The polygon's `w` plane lies at KANTELE_W_RELATIVE_EPSILON (2^-40) · (largest w), or
+// KANTELE_W_EPSILON (`W_MIN`) if larger.
 
 // `dot(plane, p) − offset` in double, as glam's `DVec4::dot` (x, y, z, w in order).
 __device__ __forceinline__ double clip_distance(D4 plane, double offset, D4 p) {

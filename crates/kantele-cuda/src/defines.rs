@@ -4,7 +4,7 @@
 use std::mem::size_of;
 
 use kantele_rules::fixed;
-use kantele_rules::geometry::clip::{MAX_CLIPPED_VERTICES, W_EPSILON};
+use kantele_rules::geometry::clip::{MAX_CLIPPED_VERTICES, W_EPSILON, W_RELATIVE_EPSILON};
 use kantele_rules::setup::TriangleSetup;
 use kantele_rules::shade::texture::{Filter, MinFilter, Wrap};
 use kantele_rules::vertex::StandardVertex;
@@ -34,6 +34,16 @@ fn float_literal(v: f32) -> String {
         format!("{text}f")
     } else {
         format!("{text}.0f")
+    }
+}
+
+/// A C double literal that reads back as exactly `v`.
+fn double_literal(v: f64) -> String {
+    let text = format!("{v:?}");
+    if text.contains(['.', 'e', 'E']) {
+        text
+    } else {
+        format!("{text}.0")
     }
 }
 
@@ -125,6 +135,10 @@ pub fn defines() -> Vec<(String, String)> {
         float_literal(fixed::GUARD_BAND_PIXELS),
     ));
     d.push(("KANTELE_W_EPSILON".into(), float_literal(W_EPSILON)));
+    d.push((
+        "KANTELE_W_RELATIVE_EPSILON".into(),
+        double_literal(W_RELATIVE_EPSILON),
+    ));
     d
 }
 
@@ -173,6 +187,11 @@ mod tests {
             assert_eq!(parsed.to_bits(), v.to_bits(), "{text}");
         }
         assert_eq!(float_literal(16384.0), "16384.0f");
+        for v in [W_RELATIVE_EPSILON, 1.0, 0.1, -2.5e-300] {
+            let text = double_literal(v);
+            let parsed: f64 = text.parse().expect("number");
+            assert_eq!(parsed.to_bits(), v.to_bits(), "{text}");
+        }
     }
 
     #[test]
@@ -198,6 +217,10 @@ mod tests {
             fixed::SUBPIXEL_BITS.to_string()
         );
         assert_eq!(get("KANTELE_W_EPSILON"), float_literal(W_EPSILON));
+        assert_eq!(
+            get("KANTELE_W_RELATIVE_EPSILON"),
+            double_literal(W_RELATIVE_EPSILON)
+        );
         // Plain data of the sizes the kernels assume (8-byte alignment for the i64 fields).
         assert_eq!(size_of::<TriangleSetup>() % 8, 0);
     }
