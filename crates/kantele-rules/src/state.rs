@@ -10,6 +10,8 @@ use kantele_lanes::{F32x8, Lanes};
 
 /// Largest render target side in pixels.
 pub const MAX_TARGET_SIZE: u32 = 16384;
+/// Largest texture side accepted (texels).
+pub const MAX_TEXTURE_SIZE: u32 = 16384;
 /// Most `f32` varyings a vertex can carry to the fragment stage.
 pub const MAX_VARYINGS: usize = 16;
 /// Most primitive-stage batches one frame may hold (2^19): a binned triangle's reference packs

@@ -1,10 +1,11 @@
-//! Draw calls: the index buffer and the type-erased draw that runs each stage's loop compiled for
-//! its concrete shader.
+//! Draw jobs: each stage's work for one recorded draw ([`DrawCall`]), behind the stages' job
+//! traits, so each stage's loop runs compiled for the draw's concrete shader.
 
 use glam::Vec4;
 
-use super::fragment::{shade_triangle, RasterCounters};
-use super::geometry::{PrimitiveBatch, ShadedVertices, TargetSpace};
+use super::call::DrawCall;
+use super::fragment::{shade_triangle, RasterCounters, RasterJob};
+use super::geometry::{GeometryJob, PrimitiveBatch, ShadedVertices, TargetSpace};
 use super::multisample::shade_triangle_multisampled;
 use super::packed_rows::PackedRows;
 use super::shader::Shader;
@@ -16,90 +17,14 @@ use kantele_rules::geometry::clip::{classify_codes, ClipCode, ClipPolygon, ClipT
 use kantele_rules::setup::{
     setup_window_triangle, SetupReject, TriangleSetup, Viewport, WindowVertex,
 };
-use kantele_rules::state::{RenderState, Topology};
+use kantele_rules::state::Topology;
 use kantele_rules::MAX_VARYINGS;
 
-/// An index buffer.
-#[derive(Clone, Copy, Debug)]
-pub enum Indices<'a> {
-    /// Vertices taken in order, three per triangle.
-    None,
-    /// 16-bit indices.
-    U16(&'a [u16]),
-    /// 32-bit indices.
-    U32(&'a [u32]),
-}
+/// A queued draw with its shader type erased: the geometry stage's job and the raster's job
+/// of one draw, so the hot loops inside are compiled for the concrete shader.
+pub(super) trait DrawJob: GeometryJob + RasterJob {}
 
-impl Indices<'_> {
-    #[inline]
-    pub(super) fn get(&self, i: usize) -> usize {
-        match self {
-            Indices::None => i,
-            Indices::U16(ix) => ix[i] as usize,
-            Indices::U32(ix) => ix[i] as usize,
-        }
-    }
-
-    pub(super) fn len(&self, vertex_count: usize) -> usize {
-        match self {
-            Indices::None => vertex_count,
-            Indices::U16(ix) => ix.len(),
-            Indices::U32(ix) => ix.len(),
-        }
-    }
-}
-
-/// A queued draw with its shader type erased; the methods run the stages for it, so the hot
-/// loops inside are compiled for the concrete shader.
-pub(super) trait DrawJob: Sync {
-    fn vertex_count(&self) -> usize;
-    fn varying_count(&self) -> usize;
-    /// Triangles, lines or points, by the draw's topology.
-    fn primitive_count(&self) -> usize;
-    fn shade_vertices(&self, first: usize, pos: &mut [Vec4], varyings: &mut [f32]);
-    /// Whether a triangle of this draw wholly behind a tile's depth bound can be skipped there:
-    /// the test is LESS or LEQUAL (its fragments would all fail, and shaders have no side
-    /// effects to miss).
-    fn rejects_by_depth_bound(&self) -> bool;
-    fn sort_order(&self, shaded: &ShadedVertices) -> Option<Vec<u32>>;
-    fn assemble(
-        &self,
-        draw: u32,
-        triangles: std::ops::Range<usize>,
-        order: Option<&[u32]>,
-        shaded: &ShadedVertices,
-        target: &TargetSpace,
-        out: &mut PrimitiveBatch,
-    );
-    /// Shades the triangle's pixels in `coverage` into one tile (`packed`: the tile's storage
-    /// for packed rows).
-    fn raster(
-        &self,
-        tri: &TriangleSetup,
-        attrs: &[f32],
-        coverage: &BlockCoverage,
-        packed: &mut PackedRows,
-        tile: &mut TileBuffer,
-        isa: Isa,
-    ) -> RasterCounters;
-    /// Shades the triangle's covered samples in `coverage` into one multisampled tile.
-    fn raster_multisampled(
-        &self,
-        tri: &TriangleSetup,
-        attrs: &[f32],
-        coverage: &SampleCoverage,
-        tile: &mut TileBuffer,
-        isa: Isa,
-    ) -> RasterCounters;
-}
-
-pub(super) struct DrawCall<'a, S: Shader> {
-    pub(super) shader: &'a S,
-    pub(super) vertices: &'a [S::Vertex],
-    pub(super) indices: Indices<'a>,
-    pub(super) topology: Topology,
-    pub(super) state: RenderState,
-}
+impl<T: GeometryJob + RasterJob + ?Sized> DrawJob for T {}
 
 impl<S: Shader> DrawCall<'_, S> {
     #[inline]
@@ -142,7 +67,7 @@ impl<S: Shader> DrawCall<'_, S> {
     }
 }
 
-impl<S: Shader> DrawJob for DrawCall<'_, S> {
+impl<S: Shader> GeometryJob for DrawCall<'_, S> {
     fn vertex_count(&self) -> usize {
         self.vertices.len()
     }
@@ -161,14 +86,6 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
             let out = &mut varyings[i * n..(i + 1) * n];
             *p = self.shader.vertex(&self.vertices[first + i], out);
         }
-    }
-
-    fn rejects_by_depth_bound(&self) -> bool {
-        self.state.depth_test
-            && matches!(
-                self.state.depth_func,
-                DepthFunc::Less | DepthFunc::LessEqual
-            )
     }
 
     fn sort_order(&self, shaded: &ShadedVertices) -> Option<Vec<u32>> {
@@ -253,6 +170,16 @@ impl<S: Shader> DrawJob for DrawCall<'_, S> {
                 }
             }
         }
+    }
+}
+
+impl<S: Shader> RasterJob for DrawCall<'_, S> {
+    fn rejects_by_depth_bound(&self) -> bool {
+        self.state.depth_test
+            && matches!(
+                self.state.depth_func,
+                DepthFunc::Less | DepthFunc::LessEqual
+            )
     }
 
     fn raster(

@@ -8,7 +8,7 @@
 //! the SIMD builds give the same picture bit for bit.
 
 use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
-use super::draw::{DrawCall, DrawJob};
+use super::call::DrawCall;
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
 use super::shader::{
@@ -16,6 +16,7 @@ use super::shader::{
     Shader,
 };
 use crate::raster::bin::{TileBins, TriangleRef};
+use crate::raster::samples::SampleCoverage;
 use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
 use crate::rop::{BlendMode, BlockRows, DeferredClear, DepthFunc, Framebuffer, TileBuffer};
 use kantele_lanes::{dispatch, prefetch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8, MaskOf};
@@ -24,6 +25,35 @@ use kantele_rules::setup::TriangleSetup;
 use kantele_rules::state::RenderState;
 
 use super::packed_rows::{packing_saves_a_row, PackedRows};
+
+/// The raster's work for one draw, with the draw's shader type erased
+/// ([`DrawJob`](super::draw::DrawJob) for the whole draw).
+pub(super) trait RasterJob: Sync {
+    /// Whether a triangle of this draw wholly behind a tile's depth bound can be skipped there:
+    /// the test is LESS or LEQUAL (its fragments would all fail, and shaders have no side
+    /// effects to miss).
+    fn rejects_by_depth_bound(&self) -> bool;
+    /// Shades the triangle's pixels in `coverage` into one tile (`packed`: the tile's storage
+    /// for packed rows).
+    fn raster(
+        &self,
+        tri: &TriangleSetup,
+        attrs: &[f32],
+        coverage: &BlockCoverage,
+        packed: &mut PackedRows,
+        tile: &mut TileBuffer,
+        isa: Isa,
+    ) -> RasterCounters;
+    /// Shades the triangle's covered samples in `coverage` into one multisampled tile.
+    fn raster_multisampled(
+        &self,
+        tri: &TriangleSetup,
+        attrs: &[f32],
+        coverage: &SampleCoverage,
+        tile: &mut TileBuffer,
+        isa: Isa,
+    ) -> RasterCounters;
+}
 
 /// Fragment counters of one tile.
 #[derive(Clone, Copy, Debug, Default)]
@@ -56,27 +86,17 @@ impl RasterCounters {
 /// single tiles balanced as well and cost more on full-screen fill.
 pub(super) const TILES_PER_PIECE: usize = 4;
 
-/// Rasterizes every tile's bin, tiles in parallel, each tile's triangles in order.
-pub(super) fn raster_tiles(
+/// Rasterizes every tile's bin of a single-sampled frame, tiles in parallel, each tile's
+/// triangles in order (a multisampled frame: `multisample::raster_tiles_multisampled`).
+pub(super) fn raster_tiles<J: RasterJob + ?Sized>(
     framebuffer: &mut Framebuffer,
     bins: &TileBins,
     geometry: &GeometryOutput<'_>,
-    draws: &[Box<dyn DrawJob + '_>],
+    draws: &[Box<J>],
     strategy: Strategy,
     isa: Isa,
     budget: &FrameBudget<'_>,
 ) -> RasterCounters {
-    if framebuffer.samples().is_multisampled() {
-        return super::multisample::raster_tiles_multisampled(
-            framebuffer,
-            bins,
-            geometry,
-            draws,
-            strategy,
-            isa,
-            budget,
-        );
-    }
     let grid = *framebuffer.grid();
     framebuffer.par_tiles(
         TILES_PER_PIECE,

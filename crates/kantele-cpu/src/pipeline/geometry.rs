@@ -8,10 +8,29 @@ use glam::Vec4;
 use rayon::prelude::*;
 
 use super::budget::FrameBudget;
-use super::draw::DrawJob;
 use kantele_rules::geometry::clip::{ClipCode, GuardBand};
 use kantele_rules::setup::{PixelRect, TriangleSetup, Viewport, WindowVertex};
 use kantele_rules::stats::FrameStats;
+
+/// The geometry stage's work for one draw, with the draw's shader type erased
+/// ([`DrawJob`](super::draw::DrawJob) for the whole draw).
+pub(super) trait GeometryJob: Sync {
+    fn vertex_count(&self) -> usize;
+    fn varying_count(&self) -> usize;
+    /// Triangles, lines or points, by the draw's topology.
+    fn primitive_count(&self) -> usize;
+    fn shade_vertices(&self, first: usize, pos: &mut [Vec4], varyings: &mut [f32]);
+    fn sort_order(&self, shaded: &ShadedVertices) -> Option<Vec<u32>>;
+    fn assemble(
+        &self,
+        draw: u32,
+        triangles: std::ops::Range<usize>,
+        order: Option<&[u32]>,
+        shaded: &ShadedVertices,
+        target: &TargetSpace,
+        out: &mut PrimitiveBatch,
+    );
+}
 
 /// Triangle counters of the primitive stage.
 #[derive(Clone, Copy, Debug, Default)]
@@ -159,8 +178,8 @@ impl GeometryScratch {
     }
 }
 
-pub(super) fn run_geometry(
-    draws: &[Box<dyn DrawJob + '_>],
+pub(super) fn run_geometry<J: GeometryJob + ?Sized>(
+    draws: &[Box<J>],
     viewport: &Viewport,
     stats: &mut FrameStats,
     scratch: &mut GeometryScratch,

@@ -14,6 +14,7 @@
 //! picture is identical for every thread count and traversal strategy.
 
 mod budget;
+mod call;
 mod draw;
 mod fragment;
 mod geometry;
@@ -31,7 +32,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec4;
 
-pub use self::draw::Indices;
+pub use self::call::Indices;
 pub use self::shader::{
     FnShader, Fragment, FragmentLanes, LaneProgram, LaneProgramJob, ShadedLanes, Shader,
     ShaderLanes,
@@ -40,7 +41,8 @@ pub use self::workers::PIN_ENV;
 pub use kantele_rules::state::{RenderState, Topology};
 
 use self::budget::FrameBudget;
-use self::draw::{DrawCall, DrawJob};
+use self::call::DrawCall;
+use self::draw::DrawJob;
 use self::geometry::{run_geometry, GeometryScratch};
 use self::warm::{WarmWorkers, WARM_AFTER_FRAME, WARM_WHILE_QUEUING};
 use crate::raster::bin::TileBins;
@@ -428,15 +430,19 @@ impl<'a> Frame<'_, 'a> {
             }
 
             let raster_start = Instant::now();
-            let counters = fragment::raster_tiles(
-                framebuffer,
-                bins,
-                &geometry,
-                &draws,
-                strategy,
-                isa,
-                &budget,
-            );
+            let counters = if framebuffer.samples().is_multisampled() {
+                multisample::raster_tiles_multisampled(
+                    framebuffer,
+                    bins,
+                    &geometry,
+                    &draws,
+                    strategy,
+                    isa,
+                    &budget,
+                )
+            } else {
+                fragment::raster_tiles(framebuffer, bins, &geometry, &draws, strategy, isa, &budget)
+            };
             stats.fragments_covered = counters.covered;
             stats.tiles_depth_rejected = counters.tile_rejected;
             stats.blocks_depth_rejected = counters.blocks_rejected;

@@ -16,8 +16,10 @@
 //! block or tile is skipped only when every sample in it would fail.
 
 use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
-use super::draw::{DrawCall, DrawJob};
-use super::fragment::{binned_triangles, RasterCounters, TriangleLanes, TILES_PER_PIECE};
+use super::call::DrawCall;
+use super::fragment::{
+    binned_triangles, RasterCounters, RasterJob, TriangleLanes, TILES_PER_PIECE,
+};
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
 use super::shader::{constant_varyings, vertex_varyings, FragmentLanes, Interpolation, Shader};
@@ -31,11 +33,11 @@ use kantele_rules::setup::TriangleSetup;
 
 /// Rasterizes every tile's bin into a multisampled framebuffer, tiles in parallel, each tile's
 /// triangles in order.
-pub(super) fn raster_tiles_multisampled(
+pub(super) fn raster_tiles_multisampled<J: RasterJob + ?Sized>(
     framebuffer: &mut Framebuffer,
     bins: &TileBins,
     geometry: &GeometryOutput<'_>,
-    draws: &[Box<dyn DrawJob + '_>],
+    draws: &[Box<J>],
     strategy: Strategy,
     isa: Isa,
     budget: &FrameBudget<'_>,

@@ -4,7 +4,7 @@
 //! path unchanged. Points and lines are never culled and always face the viewer (OpenGL 3.3
 //! §3.6.1: only polygons have a back face).
 
-use super::draw::DrawCall;
+use super::call::DrawCall;
 use super::geometry::{PrimitiveBatch, ShadedVertices, TargetSpace};
 use super::shader::Shader;
 use kantele_rules::geometry::clip::{ClipVertex, GuardBand};

@@ -1,7 +1,7 @@
 //! Where each level of a texture's mip chain lies: a [`LevelTable`] of offsets and sizes, and
 //! the same values as [`LaneTable`]s, the form the lane-wide sampler looks them up in.
 
-use super::texture::MAX_TEXTURE_SIZE;
+use crate::state::MAX_TEXTURE_SIZE;
 
 /// Where each mip level lies in the texel storage, one entry per level (level 0 first), and
 /// the same as [`LaneTable`]s for the lane-wide sampler.

@@ -12,7 +12,14 @@ use glam::Vec4;
 
 use crate::color::{encode_rgba8, srgb_to_linear};
 
-use super::texture::ColorSpace;
+/// How the 8-bit channels of an image are encoded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ColorSpace {
+    /// Values are linear intensities.
+    Linear,
+    /// RGB channels are sRGB-encoded (alpha is always linear).
+    Srgb,
+}
 
 /// Packs four bytes `[r, g, b, a]` into one texel (red in the low byte).
 #[inline]

@@ -24,27 +24,17 @@ use std::sync::OnceLock;
 use glam::{Vec2, Vec4};
 
 use super::levels::{lane_table, LaneTable, LevelTable};
+pub use super::texel::ColorSpace;
 use super::texel::{
     decode_table, decode_texel, encode_texel, pack_rgba8, srgb_texel_to_linear15, unpack_rgba8,
 };
 use crate::error::RenderError;
-
-/// Largest texture side accepted (texels).
-pub const MAX_TEXTURE_SIZE: u32 = 16384;
+pub use crate::state::MAX_TEXTURE_SIZE;
 
 /// Largest level 0 (texels) of an sRGB texture whose texels the lane-wide sampler keeps decoded
 /// to 15-bit linear units ([`Texture::prepare_lane_sampling`]): 2048 × 2048, a copy of at most
 /// 45 MB.
 const LINEAR15_MAX_TEXELS: usize = 2048 * 2048;
-
-/// How the 8-bit channels of an image are encoded.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum ColorSpace {
-    /// Values are linear intensities.
-    Linear,
-    /// RGB channels are sRGB-encoded (alpha is always linear).
-    Srgb,
-}
 
 /// One level of a mip chain: a view into the texture's storage.
 #[derive(Clone, Copy, Debug)]
