@@ -17,6 +17,7 @@
 //! The argument definitions are in [`cli`], and backend construction is in [`backends`].
 //! Errors are printed as one line, `kantele: error: …`, on stderr and exit with status 2. This
 //! crate is the only place where Kantele talks to people. The libraries return typed errors.
+#![forbid(unsafe_code)]
 
 mod animation;
 mod backends;
