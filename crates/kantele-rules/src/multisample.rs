@@ -62,6 +62,7 @@ impl SampleCount {
     pub const ALL: [SampleCount; 3] = [SampleCount::X1, SampleCount::X4, SampleCount::X8];
 
     /// The count as a number (1, 4 or 8).
+    #[inline]
     pub fn count(self) -> usize {
         match self {
             SampleCount::X1 => 1,
@@ -71,6 +72,7 @@ impl SampleCount {
     }
 
     /// Whether this is more than one sample per pixel.
+    #[inline]
     pub fn is_multisampled(self) -> bool {
         self != SampleCount::X1
     }
@@ -86,6 +88,7 @@ impl SampleCount {
     }
 
     /// Sample positions in 1/16 pixel from the pixel's top-left corner (x right, y down).
+    #[inline]
     pub fn positions_sixteenths(self) -> &'static [[i64; 2]] {
         match self {
             SampleCount::X1 => &[[8, 8]],
@@ -95,6 +98,7 @@ impl SampleCount {
     }
 
     /// Sample offsets from the pixel centre in sub-pixel units (exact).
+    #[inline]
     pub fn offsets_subpixel(self) -> [[i64; 2]; MAX_SAMPLES] {
         let mut out = [[0; 2]; MAX_SAMPLES];
         let to_subpixel = |p: i64| (p << (SUBPIXEL_BITS - 4)) - SUBPIXEL_HALF;
@@ -106,6 +110,7 @@ impl SampleCount {
 
     /// The largest distance (sub-pixel units, in x or y) of a sample from its pixel centre: how
     /// far beyond the pixel centres a triangle's pixel box must reach.
+    #[inline]
     pub fn reach_subpixel(self) -> i64 {
         self.offsets_subpixel()
             .iter()

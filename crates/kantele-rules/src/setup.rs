@@ -27,11 +27,13 @@ pub struct PixelRect {
 
 impl PixelRect {
     /// Whether the rectangle holds no pixel.
+    #[inline]
     pub fn is_empty(&self) -> bool {
         self.x0 >= self.x1 || self.y0 >= self.y1
     }
 
     /// The overlap of two rectangles (possibly empty).
+    #[inline]
     pub fn intersect(&self, other: &PixelRect) -> PixelRect {
         PixelRect {
             x0: self.x0.max(other.x0),
@@ -42,11 +44,13 @@ impl PixelRect {
     }
 
     /// Width in pixels (0 when empty).
+    #[inline]
     pub fn width(&self) -> i32 {
         (self.x1 - self.x0).max(0)
     }
 
     /// Height in pixels (0 when empty).
+    #[inline]
     pub fn height(&self) -> i32 {
         (self.y1 - self.y0).max(0)
     }
@@ -235,6 +239,7 @@ impl Viewport {
     }
 
     /// The whole target as a pixel rectangle.
+    #[inline]
     pub fn rect(&self) -> PixelRect {
         PixelRect {
             x0: 0,

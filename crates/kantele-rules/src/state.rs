@@ -181,6 +181,7 @@ pub enum Topology {
 
 impl Topology {
     /// Indices per primitive: 3, 2 or 1.
+    #[inline]
     pub fn vertices_per_primitive(self) -> usize {
         match self {
             Topology::Triangles => 3,

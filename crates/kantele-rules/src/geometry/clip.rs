@@ -174,6 +174,7 @@ pub struct ClipPolygon {
 
 impl ClipPolygon {
     /// The triangle `a, b, c`.
+    #[inline]
     pub fn triangle(a: ClipVertex, b: ClipVertex, c: ClipVertex) -> Self {
         let mut vertices = [a; MAX_CLIPPED_VERTICES];
         vertices[1] = b;
@@ -190,6 +191,7 @@ impl ClipPolygon {
     }
 
     /// The vertices, in order (same winding as the input triangle).
+    #[inline]
     pub fn vertices(&self) -> &[ClipVertex] {
         &self.vertices[..self.len]
     }

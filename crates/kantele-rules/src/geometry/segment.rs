@@ -105,6 +105,7 @@ fn cut(range: &mut (f64, f64), a: DVec4, b: DVec4, plane: DVec4, offset: f64) {
 
 /// Whether a point is drawn: finite, `w ≥ W_MIN` and inside the view volume
 /// `−w ≤ x, y, z ≤ w`.
+#[inline]
 pub fn point_inside(p: Vec4) -> bool {
     p.is_finite() && p.w >= W_MIN && p.x.abs() <= p.w && p.y.abs() <= p.w && p.z.abs() <= p.w
 }

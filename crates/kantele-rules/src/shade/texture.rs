@@ -217,21 +217,25 @@ impl Texture {
     }
 
     /// Width of level 0 in texels.
+    #[inline]
     pub fn width(&self) -> u32 {
         self.levels.widths[0]
     }
 
     /// Height of level 0 in texels.
+    #[inline]
     pub fn height(&self) -> u32 {
         self.levels.heights[0]
     }
 
     /// How many levels the mip chain has (level 0 down to 1 × 1).
+    #[inline]
     pub fn level_count(&self) -> usize {
         self.levels.offsets.len()
     }
 
     /// Level `index` of the mip chain, `None` past the last.
+    #[inline]
     pub fn level(&self, index: usize) -> Option<MipLevel<'_>> {
         let offset = *self.levels.offsets.get(index)? as usize;
         let (width, height) = (self.levels.widths[index], self.levels.heights[index]);
@@ -250,6 +254,7 @@ impl Texture {
 
     /// The encoding of the stored red, green and blue bytes (the 8-bit data the texture was made
     /// from; [`ColorSpace::Linear`] for float images).
+    #[inline]
     pub fn source_color_space(&self) -> ColorSpace {
         self.color_space
     }
@@ -428,6 +433,7 @@ impl MinFilter {
     }
 
     /// Whether this filter reads levels other than level 0.
+    #[inline]
     pub fn uses_mipmaps(self) -> bool {
         !matches!(self, MinFilter::Nearest | MinFilter::Linear)
     }
