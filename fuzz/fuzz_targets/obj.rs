@@ -1,4 +1,4 @@
-//! Fuzz target `obj`: see `kantele_scene::fuzz_targets::obj`.
+//! Fuzz target `obj`: see `kantele_testkit::fuzz_targets::obj`.
 #![no_main]
 
-libfuzzer_sys::fuzz_target!(|data: &[u8]| kantele_scene::fuzz_targets::obj(data));
+libfuzzer_sys::fuzz_target!(|data: &[u8]| kantele_testkit::fuzz_targets::obj(data));

@@ -1,5 +1,5 @@
 //! Scene loading for Kantele: glTF 2.0 (`.gltf`, `.glb`) and OBJ/MTL files into a
-//! [`kantele::scene::Scene`], by the rules of the reference scenes, plus built-in demo scenes.
+//! [`kantele_rules::scene::Scene`], by the rules of the reference scenes, plus built-in demo scenes.
 //!
 //! The rules (draw order, camera, light, extras, materials) are those of
 //! `docs/rendering-rules.md`; the glTF loader follows them exactly, the OBJ loader and the
@@ -12,7 +12,7 @@
 //! - [`builtin_scenes`] lists the built-in scenes (`cube`, `teapot`, `ground`, `pixel-edges`),
 //!   generated in code with no asset files, and [`builtin_scene`] builds one by name.
 //! - Each call returns a [`LoadedScene`]: the [`Scene`], ready for any
-//!   [`Backend`](kantele::backend::Backend), and a [`SceneInfo`] with facts and warnings about
+//!   [`Backend`](kantele_rules::backend::Backend), and a [`SceneInfo`] with facts and warnings about
 //!   the source.
 //! - [`mesh_util`] holds helpers shared by the loaders (flat normals, strips and fans to lists,
 //!   a framing camera); [`texture_util`] the procedural textures of the built-in scenes.
@@ -35,16 +35,13 @@
 
 use std::path::{Path, PathBuf};
 
-use kantele::scene::Scene;
+use kantele_rules::scene::Scene;
 use thiserror::Error;
 
 mod accessor;
 mod budget;
 mod builtin;
 mod ear_clip;
-/// Bodies of the fuzz targets in `fuzz/`, callable from stable tests (not a public API).
-#[doc(hidden)]
-pub mod fuzz_targets;
 mod gltf_loader;
 mod gltf_patch;
 pub mod mesh_util;
@@ -58,6 +55,14 @@ pub mod texture_util;
 mod uri;
 
 pub use mesh_util::flat_normals;
+
+/// Where the last panic that the loaders caught on this thread (one of a dependency's known
+/// panics, turned into a [`LoadError`]) was raised: the fuzz targets in `kantele-testkit` tell
+/// a dependency's panic from one in Kantele's own code by it (not a public API).
+#[doc(hidden)]
+pub fn last_caught_panic_file() -> Option<String> {
+    quiet_panic::last_caught_file()
+}
 
 /// A loaded scene with what a user checks before rendering it.
 #[derive(Clone, Debug)]

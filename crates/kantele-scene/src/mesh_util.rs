@@ -1,7 +1,7 @@
 //! Mesh helpers shared by the loaders and the built-in scenes.
 
 use glam::Vec3;
-use kantele::scene::{Camera, Mesh, Scene};
+use kantele_rules::scene::{Camera, Mesh, Scene};
 
 /// The direction (towards the eye) a made-up camera looks from: in front, slightly above and to
 /// the right.
@@ -113,7 +113,7 @@ mod tests {
             colors: Some(vec![Vec4::ONE, Vec4::X, Vec4::Y, Vec4::Z]),
             indices: vec![0, 1, 2, 0, 2, 3],
             material: 0,
-            topology: kantele::scene::Topology::Triangles,
+            topology: kantele_rules::scene::Topology::Triangles,
         }
     }
 

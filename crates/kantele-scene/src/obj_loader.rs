@@ -6,8 +6,10 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use kantele::scene::{AlphaMode, Draw, Light, Material, Mesh, Scene, TextureBinding, Topology};
-use kantele::shade::texture::Texture;
+use kantele_rules::scene::{
+    AlphaMode, Draw, Light, Material, Mesh, Scene, TextureBinding, Topology,
+};
+use kantele_rules::shade::texture::Texture;
 
 use crate::budget::Budget;
 use crate::ear_clip::triangulate;

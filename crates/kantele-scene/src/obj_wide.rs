@@ -4,7 +4,7 @@
 //! indices count back from the last `v` read so far.
 
 use glam::Vec3;
-use kantele::scene::Topology;
+use kantele_rules::scene::Topology;
 
 use crate::obj_text::UNNAMED_MATERIAL;
 

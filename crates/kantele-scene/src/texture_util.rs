@@ -1,6 +1,6 @@
 //! Texture decoding and procedural textures.
 
-use kantele::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
+use kantele_rules::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
 
 use crate::budget::Budget;
 
@@ -58,7 +58,7 @@ pub(crate) fn decode_srgb_within(
     budget: &mut Budget,
 ) -> Result<Texture, ImageError> {
     let (width, height) = image_size(bytes, mime_type)?;
-    let max = kantele::shade::texture::MAX_TEXTURE_SIZE;
+    let max = kantele_rules::shade::texture::MAX_TEXTURE_SIZE;
     if width == 0 || height == 0 || width > max || height > max {
         return Err(ImageError::Decode(format!(
             "image size {width}x{height} is outside 1..={max}"
@@ -116,7 +116,7 @@ pub fn trilinear_repeat() -> Sampler {
 /// A `size` × `size` sRGB checkerboard of `squares` × `squares` squares in two colours (8-bit
 /// sRGB RGB), the top-left square in `a`. `size` is clamped to `1..=MAX_TEXTURE_SIZE`.
 pub fn checker(size: u32, squares: u32, a: [u8; 3], b: [u8; 3]) -> Texture {
-    let size = size.clamp(1, kantele::shade::texture::MAX_TEXTURE_SIZE);
+    let size = size.clamp(1, kantele_rules::shade::texture::MAX_TEXTURE_SIZE);
     let cell = (size / squares.max(1)).max(1);
     let mut rgba = Vec::with_capacity(size as usize * size as usize * 4);
     for y in 0..size {

@@ -17,6 +17,10 @@
 
 pub mod compare;
 pub mod demo;
+/// Bodies of the `gltf` and `obj` fuzz targets in `fuzz/`, callable from stable tests (not a
+/// public API).
+#[doc(hidden)]
+pub mod fuzz_targets;
 
 use std::fmt::Display;
 use std::path::{Path, PathBuf};

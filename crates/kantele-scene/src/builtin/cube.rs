@@ -3,8 +3,8 @@
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use kantele::camera;
-use kantele::scene::{Camera, Draw, Light, Material, Mesh, Scene, TextureBinding};
+use kantele_rules::camera;
+use kantele_rules::scene::{Camera, Draw, Light, Material, Mesh, Scene, TextureBinding};
 
 use super::CLEAR_COLOR;
 use crate::texture_util::{checker, trilinear_repeat};
@@ -65,7 +65,7 @@ pub fn cube_mesh(material: usize) -> Mesh {
         colors: Some(vec![Vec4::ONE; 24]),
         indices,
         material,
-        topology: kantele::scene::Topology::Triangles,
+        topology: kantele_rules::scene::Topology::Triangles,
     }
 }
 

@@ -3,8 +3,8 @@
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use kantele::camera;
-use kantele::scene::{Camera, Draw, Light, Material, Mesh, Scene, TextureBinding};
+use kantele_rules::camera;
+use kantele_rules::scene::{Camera, Draw, Light, Material, Mesh, Scene, TextureBinding};
 
 use super::cube::cube_mesh;
 use super::CLEAR_COLOR;
@@ -36,7 +36,7 @@ fn ground_mesh(material: usize) -> Mesh {
         colors: None,
         indices: vec![0, 1, 2, 0, 2, 3],
         material,
-        topology: kantele::scene::Topology::Triangles,
+        topology: kantele_rules::scene::Topology::Triangles,
     }
 }
 
@@ -59,7 +59,7 @@ fn triangle_mesh(material: usize) -> Mesh {
         indices: vec![0, 1, 2],
         positions,
         material,
-        topology: kantele::scene::Topology::Triangles,
+        topology: kantele_rules::scene::Topology::Triangles,
     }
 }
 

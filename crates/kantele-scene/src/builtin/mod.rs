@@ -7,7 +7,7 @@ mod teapot;
 mod teapot_data;
 
 use glam::Vec4;
-use kantele::scene::Scene;
+use kantele_rules::scene::Scene;
 
 use crate::{LoadedScene, SceneInfo};
 

@@ -3,7 +3,7 @@
 //! about a tenth of the picture (used to prove that `kantele compare` catches such a bug).
 
 use glam::{Mat4, Vec3, Vec4};
-use kantele::scene::{Camera, Draw, Light, Material, Mesh, Scene};
+use kantele_rules::scene::{Camera, Draw, Light, Material, Mesh, Scene};
 
 use super::CLEAR_COLOR;
 use crate::SceneInfo;
@@ -57,7 +57,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         colors: Some(colors),
         indices,
         material: 0,
-        topology: kantele::scene::Topology::Triangles,
+        topology: kantele_rules::scene::Topology::Triangles,
     };
     let scene = Scene {
         file_cameras: Vec::new(),

@@ -1,7 +1,7 @@
 //! The Utah teapot, tessellated from Newell's Bézier patches.
 
 use glam::{Mat4, Vec3, Vec4};
-use kantele::scene::{Draw, Light, Material, Mesh, Scene};
+use kantele_rules::scene::{Draw, Light, Material, Mesh, Scene};
 
 use super::teapot_data::{PATCHES, POINTS};
 use super::CLEAR_COLOR;
@@ -113,7 +113,7 @@ pub fn teapot_mesh(material: usize) -> Mesh {
         colors: None,
         indices,
         material,
-        topology: kantele::scene::Topology::Triangles,
+        topology: kantele_rules::scene::Topology::Triangles,
     }
 }
 

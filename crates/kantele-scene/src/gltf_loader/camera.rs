@@ -1,7 +1,7 @@
 //! Cameras attached to nodes (perspective and orthographic).
 
 use glam::Mat4;
-use kantele::scene::Camera;
+use kantele_rules::scene::Camera;
 
 use super::{named, Loader};
 

@@ -4,8 +4,8 @@
 use std::sync::Arc;
 
 use glam::{Mat3, Vec2, Vec3, Vec4};
-use kantele::scene::{AlphaMode, Material, TextureBinding};
-use kantele::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
+use kantele_rules::scene::{AlphaMode, Material, TextureBinding};
+use kantele_rules::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 
 use super::{named, Loader};
 use crate::accessor::BufferData;

@@ -8,7 +8,7 @@ mod primitive;
 use std::collections::HashMap;
 use std::path::Path;
 
-use kantele::scene::Scene;
+use kantele_rules::scene::Scene;
 
 use crate::budget::Budget;
 use crate::gltf_patch::{patch, split_glb, Patched};

@@ -2,7 +2,7 @@
 //! (`EXT_mesh_gpu_instancing`) and the scene's extras.
 
 use glam::{Mat4, Quat, Vec3, Vec4};
-use kantele::scene::{Draw, Light, NamedCamera};
+use kantele_rules::scene::{Draw, Light, NamedCamera};
 
 use super::{named, Loader, DEFAULT_RESOLUTION};
 use crate::accessor::{read_f32, BufferData};
@@ -249,7 +249,7 @@ impl Loader<'_> {
                 .collect()
         };
         if let Some(v) = value.get("resolution") {
-            let max = kantele::MAX_TARGET_SIZE as f64;
+            let max = kantele_rules::MAX_TARGET_SIZE as f64;
             match numbers(v).as_deref() {
                 Some(&[w, h])
                     if w >= 1.0 && h >= 1.0 && w <= max && h <= max && w.fract() == 0.0 && h.fract() == 0.0 =>

@@ -3,7 +3,7 @@
 use glam::{Mat3, Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
-use kantele::scene::{Mesh, Topology};
+use kantele_rules::scene::{Mesh, Topology};
 
 use super::{named, Loader};
 use crate::accessor::{read_f32, read_u32, BufferData};

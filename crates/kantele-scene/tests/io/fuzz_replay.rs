@@ -1,6 +1,6 @@
 //! The fuzz targets on stable: every committed corpus file under `fuzz/corpus/<target>/`, then
 //! deterministic pseudo-random mutations of them, through the same bodies `cargo fuzz` runs
-//! (`kantele::fuzz_targets`, `kantele_scene::fuzz_targets`). A defect panics, failing the test.
+//! (`kantele::fuzz_targets`, `kantele_testkit::fuzz_targets`). A defect panics, failing the test.
 //!
 //! The seed files are generated, not hand-edited: `cargo test -p kantele-scene --test io
 //! -- --ignored write_seed_corpus` writes them (inputs the fuzzer found stay as they are).
@@ -150,7 +150,7 @@ fn gltf_corpus_and_mutations() {
     replay(
         "gltf",
         0x9e37_79b9_7f4a_7c15,
-        kantele_scene::fuzz_targets::gltf,
+        kantele_testkit::fuzz_targets::gltf,
     );
 }
 
@@ -159,7 +159,7 @@ fn obj_corpus_and_mutations() {
     replay(
         "obj",
         0xd1b5_4a32_d192_ed03,
-        kantele_scene::fuzz_targets::obj,
+        kantele_testkit::fuzz_targets::obj,
     );
 }
 
@@ -321,7 +321,7 @@ fn cube_obj() -> Vec<u8> {
         text += &format!("f {} {} {}\n", tri[0] + 1, tri[1] + 1, tri[2] + 1);
     }
     let mut bytes = text.into_bytes();
-    bytes.extend_from_slice(kantele_scene::fuzz_targets::MTL_SEPARATOR);
+    bytes.extend_from_slice(kantele_testkit::fuzz_targets::MTL_SEPARATOR);
     bytes.extend_from_slice(b"newmtl red\nKd 0.8 0.2 0.1\nKa 0.1 0.1 0.1\nd 0.9\nillum 2\n");
     bytes
 }
@@ -353,7 +353,7 @@ l 1 2
 p 3
 "
     .to_vec();
-    bytes.extend_from_slice(kantele_scene::fuzz_targets::MTL_SEPARATOR);
+    bytes.extend_from_slice(kantele_testkit::fuzz_targets::MTL_SEPARATOR);
     bytes.extend_from_slice(b"newmtl textured\nKd 1 1 1\nmap_Kd missing.png\n");
     bytes
 }

@@ -14,7 +14,7 @@ use std::sync::Arc;
 use kantele::backend::{Backend, FrameView, Pass};
 use kantele::cpu::{CpuBackend, CpuOptions};
 
-use crate::{LoadError, LoadOptions, LoadedScene};
+use kantele_scene::{LoadError, LoadOptions, LoadedScene};
 
 /// Memory budget of a fuzzed load: small enough that no input can exhaust the fuzzer's memory
 /// within the budget's rules.
@@ -71,7 +71,7 @@ fn load(scene: &Path) -> Result<LoadedScene, LoadError> {
         max_memory: FUZZ_MAX_MEMORY,
         ..LoadOptions::default()
     };
-    crate::load_scene_with(scene, &options)
+    kantele_scene::load_scene_with(scene, &options)
 }
 
 /// Fails on a caught panic from Kantele's own code; renders a loaded scene.
@@ -82,7 +82,7 @@ fn check_and_render(result: Result<LoadedScene, LoadError>) {
             let message = error.to_string();
             if message.contains("the parser failed") {
                 // Dependencies' known panics are caught by design; ours are defects.
-                let file = crate::quiet_panic::last_caught_file().unwrap_or_default();
+                let file = kantele_scene::last_caught_panic_file().unwrap_or_default();
                 assert!(
                     !is_kantele_source(&file),
                     "Kantele's own code panicked in {file}: {message}"
