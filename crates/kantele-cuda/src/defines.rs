@@ -29,17 +29,17 @@ pub const STATUS_WORDS: usize = 12;
 
 /// A C float literal that reads back as exactly `v`.
 fn float_literal(v: f32) -> String {
-    let text = format!("{v:?}");
-    if text.contains(['.', 'e', 'E']) {
-        format!("{text}f")
-    } else {
-        format!("{text}.0f")
-    }
+    format!("{}f", floating_literal(format!("{v:?}")))
 }
 
 /// A C double literal that reads back as exactly `v`.
 fn double_literal(v: f64) -> String {
-    let text = format!("{v:?}");
+    floating_literal(format!("{v:?}"))
+}
+
+/// Rust's shortest round-trip text of a number (`Debug`), made a C floating literal: `16384`
+/// becomes `16384.0`, text with a point or an exponent stays as it is.
+fn floating_literal(text: String) -> String {
     if text.contains(['.', 'e', 'E']) {
         text
     } else {

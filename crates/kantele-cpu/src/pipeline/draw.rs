@@ -37,7 +37,7 @@ impl<S: Shader> DrawCall<'_, S> {
     }
 
     /// Sets up one (clipped or whole) triangle and appends it with its varyings. Always inlined
-    /// into [`DrawJob::assemble`], with [`setup_window_triangle`]: as two calls per triangle,
+    /// into [`GeometryJob::assemble`], with [`setup_window_triangle`]: as two calls per triangle,
     /// the record (over 200 bytes) went back through memory; inlined, the mesh scenes' frames
     /// are 2–23% shorter at one thread (docs/design-notes.md).
     #[inline(always)]
