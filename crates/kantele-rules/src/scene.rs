@@ -147,6 +147,20 @@ pub struct Material {
     /// sRGB emissive texture, multiplied into `emissive`; read with the base colour's
     /// texture coordinates.
     pub emissive_texture: Option<TextureBinding>,
+    /// `metallicFactor` (PBR shading; glTF default 1).
+    pub metallic: f32,
+    /// `roughnessFactor`, perceptual (PBR shading; glTF default 1).
+    pub roughness: f32,
+    /// Linear texture whose blue channel multiplies `metallic` and green `roughness`.
+    pub metallic_roughness_texture: Option<TextureBinding>,
+    /// Linear tangent-space normal texture (PBR shading).
+    pub normal_texture: Option<TextureBinding>,
+    /// Scales the normal texture's X and Y (`normalTexture.scale`).
+    pub normal_scale: f32,
+    /// Linear texture whose red channel is ambient occlusion (PBR shading, image-based light).
+    pub occlusion_texture: Option<TextureBinding>,
+    /// `occlusion = 1 + strength × (texel − 1)` (`occlusionTexture.strength`).
+    pub occlusion_strength: f32,
 }
 
 impl Default for Material {
@@ -160,9 +174,83 @@ impl Default for Material {
             unlit: false,
             emissive: Vec3::ZERO,
             emissive_texture: None,
+            metallic: 1.0,
+            roughness: 1.0,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            normal_scale: 1.0,
+            occlusion_texture: None,
+            occlusion_strength: 1.0,
         }
     }
 }
+
+impl Material {
+    /// The material's textures that PBR shading reads besides the base colour and emissive
+    /// ones: metallic-roughness, normal, occlusion.
+    pub fn pbr_textures(&self) -> [Option<TextureBinding>; 3] {
+        [
+            self.metallic_roughness_texture,
+            self.normal_texture,
+            self.occlusion_texture,
+        ]
+    }
+}
+
+/// Which shading model a scene is drawn with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Shading {
+    /// The reference scenes' rule: Lambert under one directional light with an ambient term
+    /// (`docs/rendering-rules.md`). Chosen by the loaders for reference scenes (glTF files
+    /// whose `scene.extras` carry `ambient`) and for built-in scenes.
+    #[default]
+    Lambert,
+    /// glTF 2.0's metallic-roughness model (Appendix B) under the scene's punctual lights and
+    /// environment ([`crate::shade::pbr`]).
+    Pbr,
+}
+
+impl Shading {
+    /// The command-line name: `lambert`, `pbr`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Shading::Lambert => "lambert",
+            Shading::Pbr => "pbr",
+        }
+    }
+}
+
+/// What kind of `KHR_lights_punctual` light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// Parallel light along [`PunctualLight::direction`].
+    Directional,
+    /// Light from [`PunctualLight::position`] in every direction.
+    Point,
+    /// A point light limited to a cone around [`PunctualLight::direction`].
+    Spot {
+        /// Angle from the axis where the falloff starts (radians).
+        inner_cone_angle: f32,
+        /// Angle from the axis where the light ends (radians).
+        outer_cone_angle: f32,
+    },
+}
+
+/// A punctual light placed in the world (PBR shading).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PunctualLight {
+    /// Its kind.
+    pub kind: LightKind,
+    /// Linear colour × intensity (lux for directional lights, candela for the others).
+    pub color: Vec3,
+    /// World position (point and spot lights).
+    pub position: Vec3,
+    /// World direction the light travels (the node's −Z; directional and spot lights).
+    pub direction: Vec3,
+    /// Distance where the light ends (`None`: infinite).
+    pub range: Option<f32>,
+}
+
 
 /// One draw: a mesh placed in the world by a node.
 #[derive(Clone, Debug)]
@@ -321,6 +409,17 @@ pub struct Scene {
     pub clear_color: Vec4,
     /// Image size `(width, height)` the scene asks for.
     pub resolution: (u32, u32),
+    /// The shading model.
+    pub shading: Shading,
+    /// Punctual lights of PBR shading (the Lambert rule reads [`Scene::light`]). With neither
+    /// lights nor an environment, PBR scenes are lit by a headlight.
+    pub lights: Vec<PunctualLight>,
+    /// Image-based light of PBR shading.
+    pub environment: Option<crate::shade::environment::EnvironmentLight>,
+    /// Exposure of PBR shading in stops (colour × 2^EV before the tone map).
+    pub exposure: f32,
+    /// Tone map of PBR shading.
+    pub tonemap: crate::shade::pbr::Tonemap,
 }
 
 impl Default for Scene {
@@ -336,6 +435,11 @@ impl Default for Scene {
             ambient: 0.1,
             clear_color: Vec4::new(0.0, 0.0, 0.0, 1.0),
             resolution: (800, 600),
+            shading: Shading::Lambert,
+            lights: Vec::new(),
+            environment: None,
+            exposure: 0.0,
+            tonemap: crate::shade::pbr::Tonemap::PbrNeutral,
         }
     }
 }
@@ -490,9 +594,16 @@ impl Scene {
             }
         }
         for (i, material) in self.materials.iter().enumerate() {
-            for binding in [material.base_color_texture, material.emissive_texture]
-                .into_iter()
-                .flatten()
+            let [metallic_roughness, normal, occlusion] = material.pbr_textures();
+            for binding in [
+                material.base_color_texture,
+                material.emissive_texture,
+                metallic_roughness,
+                normal,
+                occlusion,
+            ]
+            .into_iter()
+            .flatten()
             {
                 if binding.texture >= self.textures.len() {
                     return Err(RenderError::InvalidScene(format!(

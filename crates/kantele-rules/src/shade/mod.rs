@@ -1,5 +1,7 @@
 //! Shading resources: textures, their 8-bit texel format and the samplers that read them.
+pub mod environment;
 mod levels;
+pub mod pbr;
 pub mod sample_lanes;
 pub mod texel;
 mod texel_lanes;

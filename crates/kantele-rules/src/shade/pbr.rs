@@ -1,0 +1,446 @@
+//! glTF 2.0's physically based shading, written once for every backend: the metallic-roughness
+//! BRDF of the specification's Appendix B (GGX distribution, Smith height-correlated
+//! visibility, Schlick Fresnel, the metal / dielectric mix), the `KHR_lights_punctual` falloff,
+//! image-based light through an [`EnvironmentLight`], exposure and tone mapping.
+//!
+//! The functions are generic over [`Lanes`]: the CPU backend runs them on eight pixels at once,
+//! and on one pixel through the same code (a scalar [`Lanes`] with the value in every lane), so
+//! there is one sequence of operations per rule. The OpenGL shader (`kantele-gl`) follows the
+//! same formulas; `f64` versions for tests live in the tests below.
+
+use glam::Vec3;
+use kantele_lanes::{F32x8, Lanes, Mask8};
+
+use super::environment::EnvironmentLight;
+use crate::scene::{LightKind, PunctualLight};
+
+/// Reflectance at normal incidence of every dielectric (glTF: IOR 1.5).
+pub const DIELECTRIC_F0: f32 = 0.04;
+
+/// The smallest perceptual roughness the punctual lights see: below it a highlight is narrower
+/// than a pixel and `D` overflows (as Filament's `MIN_PERCEPTUAL_ROUGHNESS`). Image-based light
+/// uses the material's own roughness.
+pub const MIN_PUNCTUAL_ROUGHNESS: f32 = 0.045;
+
+/// `1 / π`, as `f32`.
+const INV_PI: f32 = std::f32::consts::FRAC_1_PI;
+
+/// How the linear colour is mapped to the displayable range after exposure.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Tonemap {
+    /// Colours are written as they are (values above 1 clip when quantised).
+    None,
+    /// Khronos PBR Neutral: colours below 0.76 keep their hue and value, brighter ones are
+    /// compressed towards white (the choice for product pictures).
+    #[default]
+    PbrNeutral,
+    /// The ACES filmic curve as fitted by Krzysztof Narkowicz, per channel.
+    Aces,
+}
+
+impl Tonemap {
+    /// The command-line name: `none`, `pbr-neutral`, `aces`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Tonemap::None => "none",
+            Tonemap::PbrNeutral => "pbr-neutral",
+            Tonemap::Aces => "aces",
+        }
+    }
+
+    /// The tone map named `name` (see [`Tonemap::name`]).
+    pub fn from_name(name: &str) -> Option<Self> {
+        [Tonemap::None, Tonemap::PbrNeutral, Tonemap::Aces]
+            .into_iter()
+            .find(|t| t.name() == name)
+    }
+}
+
+/// A punctual light as a frame sees it: world space, with the constants of its falloff.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameLight {
+    /// Colour × intensity.
+    pub color: Vec3,
+    /// Directional lights: the unit vector towards the light. Spot lights: the unit vector
+    /// along which the light shines (the node's −Z). Point lights: unused.
+    pub direction: Vec3,
+    /// Point and spot lights: the position.
+    pub position: Vec3,
+    /// `true` for a directional light (no position, no falloff).
+    pub directional: bool,
+    /// `1 / range²`, 0 without a range.
+    pub inverse_range_squared: f32,
+    /// Spot cone: `scale = 1 / max(0.001, cos inner − cos outer)`; 0 for point lights.
+    pub cone_scale: f32,
+    /// Spot cone: `offset = −cos outer × scale`; 1 for point lights (no cone).
+    pub cone_offset: f32,
+}
+
+impl FrameLight {
+    /// The frame's form of a scene light (already in world space).
+    pub fn new(light: &PunctualLight) -> Self {
+        let mut out = Self {
+            color: light.color,
+            direction: light.direction.normalize_or_zero(),
+            position: light.position,
+            directional: false,
+            inverse_range_squared: match light.range {
+                Some(r) if r.is_finite() && r > 0.0 => 1.0 / (r * r),
+                _ => 0.0,
+            },
+            cone_scale: 0.0,
+            cone_offset: 1.0,
+        };
+        match light.kind {
+            LightKind::Directional => {
+                // Stored as the direction towards the light.
+                out.direction = -out.direction;
+                out.directional = true;
+            }
+            LightKind::Point => {}
+            LightKind::Spot {
+                inner_cone_angle,
+                outer_cone_angle,
+            } => {
+                let (cos_inner, cos_outer) = (inner_cone_angle.cos(), outer_cone_angle.cos());
+                out.cone_scale = 1.0 / (cos_inner - cos_outer).max(0.001);
+                out.cone_offset = -cos_outer * out.cone_scale;
+            }
+        }
+        out
+    }
+
+    /// A directional light of colour `color` shining from `to_light` (the headlight, or the
+    /// Lambert scene's light).
+    pub fn directional(to_light: Vec3, color: Vec3) -> Self {
+        Self {
+            color,
+            direction: to_light.normalize_or_zero(),
+            position: Vec3::ZERO,
+            directional: true,
+            inverse_range_squared: 0.0,
+            cone_scale: 0.0,
+            cone_offset: 1.0,
+        }
+    }
+}
+
+/// Everything of a surface point the shading reads, per lane (world space).
+#[derive(Clone, Copy, Debug)]
+pub struct Surface<L: Lanes> {
+    /// Base colour (linear RGB).
+    pub base: [L::F32; 3],
+    /// Metalness in [0, 1].
+    pub metallic: L::F32,
+    /// Perceptual roughness in [0, 1].
+    pub roughness: L::F32,
+    /// Ambient occlusion in [0, 1], applied to image-based light only.
+    pub occlusion: L::F32,
+    /// Shading normal (unit).
+    pub normal: [L::F32; 3],
+    /// The surface point.
+    pub position: [L::F32; 3],
+}
+
+/// What lights a frame's PBR draws: the punctual lights, the environment and the eye.
+#[derive(Clone, Debug)]
+pub struct PbrLighting {
+    /// Punctual lights (directional, point, spot).
+    pub lights: Vec<FrameLight>,
+    /// Image-based light, if any.
+    pub environment: Option<EnvironmentLight>,
+    /// The eye, world space (the view vector points from the surface towards it).
+    pub eye: Vec3,
+    /// `2^EV` applied before the tone map.
+    pub exposure: f32,
+    /// The tone map.
+    pub tonemap: Tonemap,
+}
+
+#[inline(always)]
+fn dot3<L: Lanes>(a: &[L::F32; 3], b: &[L::F32; 3]) -> L::F32 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// `v / |v|`, zero where `|v|` is zero or not finite.
+#[inline(always)]
+pub fn normalize3<L: Lanes>(lanes: L, v: [L::F32; 3]) -> [L::F32; 3] {
+    let length2 = dot3::<L>(&v, &v);
+    let rcp = lanes.splat_f32(1.0) / length2.sqrt();
+    let usable = rcp
+        .abs()
+        .simd_lt(lanes.splat_f32(f32::INFINITY))
+        .and(rcp.simd_gt(lanes.splat_f32(0.0)));
+    let zero = lanes.splat_f32(0.0);
+    [
+        usable.select_f32(v[0] * rcp, zero),
+        usable.select_f32(v[1] * rcp, zero),
+        usable.select_f32(v[2] * rcp, zero),
+    ]
+}
+
+#[inline(always)]
+fn clamp01<L: Lanes>(lanes: L, x: L::F32) -> L::F32 {
+    x.max(lanes.splat_f32(0.0)).min(lanes.splat_f32(1.0))
+}
+
+/// The material's diffuse colour and reflectance at normal incidence: `c_diff = base × (1 −
+/// metallic)`, `F0 = 0.04 + (base − 0.04) × metallic`.
+#[inline(always)]
+fn diffuse_and_f0<L: Lanes>(lanes: L, s: &Surface<L>) -> ([L::F32; 3], [L::F32; 3]) {
+    let one = lanes.splat_f32(1.0);
+    let f0 = lanes.splat_f32(DIELECTRIC_F0);
+    let dielectric = one - s.metallic;
+    let c_diff = [
+        s.base[0] * dielectric,
+        s.base[1] * dielectric,
+        s.base[2] * dielectric,
+    ];
+    let f0 = [
+        f0 + (s.base[0] - f0) * s.metallic,
+        f0 + (s.base[1] - f0) * s.metallic,
+        f0 + (s.base[2] - f0) * s.metallic,
+    ];
+    (c_diff, f0)
+}
+
+/// `D × V`: the GGX distribution times the Smith height-correlated visibility, for
+/// `alpha = roughness²` (Appendix B):
+/// `D = α² / (π (NdotH² (α² − 1) + 1)²)`,
+/// `V = 0.5 / (NdotL √(NdotV² (1 − α²) + α²) + NdotV √(NdotL² (1 − α²) + α²))` (0 where the
+/// denominator is 0).
+#[inline(always)]
+pub fn ggx_d_times_v<L: Lanes>(
+    lanes: L,
+    alpha: L::F32,
+    n_dot_l: L::F32,
+    n_dot_v: L::F32,
+    n_dot_h: L::F32,
+) -> L::F32 {
+    let one = lanes.splat_f32(1.0);
+    let zero = lanes.splat_f32(0.0);
+    let a2 = alpha * alpha;
+    let f = n_dot_h * n_dot_h * (a2 - one) + one;
+    let d = a2 / (lanes.splat_f32(std::f32::consts::PI) * f * f);
+    let ggx_v = n_dot_l * (n_dot_v * n_dot_v * (one - a2) + a2).sqrt();
+    let ggx_l = n_dot_v * (n_dot_l * n_dot_l * (one - a2) + a2).sqrt();
+    let denominator = ggx_v + ggx_l;
+    let positive = denominator.simd_gt(zero);
+    let v = positive.select_f32(lanes.splat_f32(0.5) / denominator, zero);
+    d * v
+}
+
+/// Schlick's Fresnel: `F0 + (1 − F0) (1 − VdotH)⁵`.
+#[inline(always)]
+pub fn schlick<L: Lanes>(lanes: L, f0: &[L::F32; 3], v_dot_h: L::F32) -> [L::F32; 3] {
+    let one = lanes.splat_f32(1.0);
+    let m = one - v_dot_h;
+    let m2 = m * m;
+    let m5 = m2 * m2 * m;
+    [
+        f0[0] + (one - f0[0]) * m5,
+        f0[1] + (one - f0[1]) * m5,
+        f0[2] + (one - f0[2]) * m5,
+    ]
+}
+
+/// Radiance arriving from `light` at the surface point and the unit vector towards it:
+/// directional lights arrive unattenuated; point and spot lights fall off as `1 / d²`, times
+/// `clamp(1 − (d / range)⁴, 0, 1)` with a range, and spot lights by the cone,
+/// `clamp(cos θ × scale + offset, 0, 1)²` (`KHR_lights_punctual`).
+#[inline(always)]
+pub fn light_arrival<L: Lanes>(
+    lanes: L,
+    light: &FrameLight,
+    position: &[L::F32; 3],
+) -> ([L::F32; 3], L::F32) {
+    let one = lanes.splat_f32(1.0);
+    if light.directional {
+        let l = [
+            lanes.splat_f32(light.direction.x),
+            lanes.splat_f32(light.direction.y),
+            lanes.splat_f32(light.direction.z),
+        ];
+        return (l, one);
+    }
+    let d = [
+        lanes.splat_f32(light.position.x) - position[0],
+        lanes.splat_f32(light.position.y) - position[1],
+        lanes.splat_f32(light.position.z) - position[2],
+    ];
+    let distance2 = dot3::<L>(&d, &d);
+    let l = normalize3(lanes, d);
+    let mut attenuation = one / distance2;
+    if light.inverse_range_squared > 0.0 {
+        let ratio2 = distance2 * lanes.splat_f32(light.inverse_range_squared);
+        attenuation = attenuation * clamp01(lanes, one - ratio2 * ratio2);
+    }
+    if light.cone_scale > 0.0 {
+        let cos_angle = -(l[0] * lanes.splat_f32(light.direction.x)
+            + l[1] * lanes.splat_f32(light.direction.y)
+            + l[2] * lanes.splat_f32(light.direction.z));
+        let cone = clamp01(
+            lanes,
+            cos_angle * lanes.splat_f32(light.cone_scale) + lanes.splat_f32(light.cone_offset),
+        );
+        attenuation = attenuation * cone * cone;
+    }
+    // A surface at the light's position receives nothing (not infinity).
+    let finite = attenuation.abs().simd_lt(lanes.splat_f32(f32::INFINITY));
+    (l, finite.select_f32(attenuation, lanes.splat_f32(0.0)))
+}
+
+/// Outgoing radiance of one surface point towards `view` (unit, towards the eye) lit by one
+/// punctual light: `radiance × NdotL × ((1 − F) c_diff / π + F D V)` (Appendix B).
+#[inline(always)]
+fn punctual<L: Lanes>(
+    lanes: L,
+    light: &FrameLight,
+    s: &Surface<L>,
+    view: &[L::F32; 3],
+    c_diff: &[L::F32; 3],
+    f0: &[L::F32; 3],
+    alpha: L::F32,
+) -> [L::F32; 3] {
+    let (l, attenuation) = light_arrival(lanes, light, &s.position);
+    let h = normalize3(
+        lanes,
+        [view[0] + l[0], view[1] + l[1], view[2] + l[2]],
+    );
+    let n_dot_l = clamp01(lanes, dot3::<L>(&s.normal, &l));
+    let n_dot_v = clamp01(lanes, dot3::<L>(&s.normal, view));
+    let n_dot_h = clamp01(lanes, dot3::<L>(&s.normal, &h));
+    let v_dot_h = clamp01(lanes, dot3::<L>(view, &h));
+    let f = schlick(lanes, f0, v_dot_h);
+    let dv = ggx_d_times_v(lanes, alpha, n_dot_l, n_dot_v, n_dot_h);
+    let one = lanes.splat_f32(1.0);
+    let inv_pi = lanes.splat_f32(INV_PI);
+    let scale = attenuation * n_dot_l;
+    let mut out = [lanes.splat_f32(0.0); 3];
+    let color = light.color.to_array();
+    for c in 0..3 {
+        let brdf = (one - f[c]) * c_diff[c] * inv_pi + f[c] * dv;
+        out[c] = lanes.splat_f32(color[c]) * scale * brdf;
+    }
+    out
+}
+
+/// The linear colour of a lit surface point, before exposure and tone mapping: every punctual
+/// light by [`punctual`], plus image-based light (diffuse irradiance × `c_diff × (1 − FssEss)`
+/// and the pre-filtered specular radiance × `FssEss = F0 A + B`, both × occlusion), where `A`,
+/// `B` are the split-sum terms of the environment's BRDF table.
+#[inline(always)]
+pub fn shade<L: Lanes>(lanes: L, lighting: &PbrLighting, s: &Surface<L>) -> [L::F32; 3] {
+    let view = normalize3(
+        lanes,
+        [
+            lanes.splat_f32(lighting.eye.x) - s.position[0],
+            lanes.splat_f32(lighting.eye.y) - s.position[1],
+            lanes.splat_f32(lighting.eye.z) - s.position[2],
+        ],
+    );
+    let (c_diff, f0) = diffuse_and_f0(lanes, s);
+    let clamped = s.roughness.max(lanes.splat_f32(MIN_PUNCTUAL_ROUGHNESS));
+    let alpha = clamped * clamped;
+    let mut color = [lanes.splat_f32(0.0); 3];
+    for light in &lighting.lights {
+        let c = punctual(lanes, light, s, &view, &c_diff, &f0, alpha);
+        for k in 0..3 {
+            color[k] = color[k] + c[k];
+        }
+    }
+    if let Some(environment) = &lighting.environment {
+        let ibl = image_based(lanes, environment, s, &view, &c_diff, &f0);
+        for k in 0..3 {
+            color[k] = color[k] + ibl[k];
+        }
+    }
+    color
+}
+
+/// The image-based part of [`shade`].
+#[inline(always)]
+fn image_based<L: Lanes>(
+    lanes: L,
+    environment: &EnvironmentLight,
+    s: &Surface<L>,
+    view: &[L::F32; 3],
+    c_diff: &[L::F32; 3],
+    f0: &[L::F32; 3],
+) -> [L::F32; 3] {
+    let one = lanes.splat_f32(1.0);
+    let n = &s.normal;
+    let n_dot_v_raw = dot3::<L>(n, view);
+    let n_dot_v = clamp01(lanes, n_dot_v_raw);
+    // R = 2 (N·V) N − V.
+    let two_n_dot_v = n_dot_v_raw + n_dot_v_raw;
+    let reflected = [
+        two_n_dot_v * n[0] - view[0],
+        two_n_dot_v * n[1] - view[1],
+        two_n_dot_v * n[2] - view[2],
+    ];
+    let irradiance = environment.irradiance_lanes(lanes, n);
+    let specular = environment.specular_lanes(lanes, &reflected, s.roughness);
+    let [a, b] = environment.brdf_lanes(lanes, n_dot_v, s.roughness);
+    let intensity = lanes.splat_f32(environment.intensity);
+    let weight = s.occlusion * intensity;
+    let mut out = [lanes.splat_f32(0.0); 3];
+    for c in 0..3 {
+        let fss_ess = f0[c] * a + b;
+        let diffuse = irradiance[c] * c_diff[c] * (one - fss_ess);
+        out[c] = (diffuse + specular[c] * fss_ess) * weight;
+    }
+    out
+}
+
+/// Exposure (`× scale`) and the tone map, per lane.
+#[inline(always)]
+pub fn tonemap<L: Lanes>(lanes: L, tonemap: Tonemap, exposure: f32, rgb: [L::F32; 3]) -> [L::F32; 3] {
+    let e = lanes.splat_f32(exposure);
+    let rgb = [rgb[0] * e, rgb[1] * e, rgb[2] * e];
+    match tonemap {
+        Tonemap::None => rgb,
+        Tonemap::PbrNeutral => pbr_neutral(lanes, rgb),
+        Tonemap::Aces => {
+            let f = |x: L::F32| {
+                let x = x.max(lanes.splat_f32(0.0));
+                let num = x * (lanes.splat_f32(2.51) * x + lanes.splat_f32(0.03));
+                let den = x * (lanes.splat_f32(2.43) * x + lanes.splat_f32(0.59))
+                    + lanes.splat_f32(0.14);
+                clamp01(lanes, num / den)
+            };
+            [f(rgb[0]), f(rgb[1]), f(rgb[2])]
+        }
+    }
+}
+
+/// Khronos PBR Neutral (the reference GLSL, operation for operation).
+#[inline(always)]
+fn pbr_neutral<L: Lanes>(lanes: L, rgb: [L::F32; 3]) -> [L::F32; 3] {
+    const START_COMPRESSION: f32 = 0.8 - 0.04;
+    const DESATURATION: f32 = 0.15;
+    let one = lanes.splat_f32(1.0);
+    let x = rgb[0].min(rgb[1].min(rgb[2]));
+    let small = x - lanes.splat_f32(6.25) * x * x;
+    let offset = x
+        .simd_lt(lanes.splat_f32(0.08))
+        .select_f32(small, lanes.splat_f32(0.04));
+    let c = [rgb[0] - offset, rgb[1] - offset, rgb[2] - offset];
+    let peak = c[0].max(c[1].max(c[2]));
+    let d = 1.0 - START_COMPRESSION;
+    let new_peak = one - lanes.splat_f32(d * d) / (peak + lanes.splat_f32(d - START_COMPRESSION));
+    let ratio = new_peak / peak;
+    let g = one - one / (lanes.splat_f32(DESATURATION) * (peak - new_peak) + one);
+    let compress = peak.simd_ge(lanes.splat_f32(START_COMPRESSION));
+    let mut out = c;
+    for k in 0..3 {
+        let scaled = c[k] * ratio;
+        let mixed = scaled + (new_peak - scaled) * g;
+        out[k] = compress.select_f32(mixed, c[k]);
+    }
+    out
+}
+
+#[cfg(test)]
+#[path = "pbr_tests.rs"]
+mod tests;
