@@ -157,6 +157,43 @@ pub struct PbrLighting {
     pub tonemap: Tonemap,
 }
 
+/// The most punctual lights a PBR frame shades with (the OpenGL shader's array size); loaders
+/// keep the first ones and warn about the rest.
+pub const MAX_LIGHTS: usize = 8;
+
+impl PbrLighting {
+    /// The lighting of one frame of `scene` seen as `view`: the scene's punctual lights (at
+    /// most [`MAX_LIGHTS`]), its environment, and — when it has neither — the view's resolved
+    /// light (the headlight) as one directional light.
+    pub fn for_frame(scene: &crate::scene::Scene, view: &crate::backend::FrameView) -> Self {
+        let mut lights: Vec<FrameLight> = scene
+            .lights
+            .iter()
+            .take(MAX_LIGHTS)
+            .map(FrameLight::new)
+            .collect();
+        if lights.is_empty() && scene.environment.is_none() {
+            lights.push(FrameLight::directional(view.to_light, view.light_color));
+        }
+        Self {
+            lights,
+            environment: scene.environment.clone(),
+            eye: view.view.inverse().transform_point3(Vec3::ZERO),
+            exposure: exposure_scale(scene.exposure),
+            tonemap: scene.tonemap,
+        }
+    }
+}
+
+/// `2^ev`, the colour scale of an exposure of `ev` stops (1 for non-finite `ev`).
+pub fn exposure_scale(ev: f32) -> f32 {
+    if ev.is_finite() {
+        ev.clamp(-64.0, 64.0).exp2()
+    } else {
+        1.0
+    }
+}
+
 #[inline(always)]
 fn dot3<L: Lanes>(a: &[L::F32; 3], b: &[L::F32; 3]) -> L::F32 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
