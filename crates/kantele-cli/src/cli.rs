@@ -76,6 +76,66 @@ pub struct SceneArgs {
     /// repeated.
     #[arg(long = "allow-read", value_name = "DIR")]
     pub allow_read: Vec<PathBuf>,
+    /// Shading model: `auto` lets the file decide (glTF reference scenes, whose extras carry
+    /// `ambient`, OBJ files and built-ins are drawn with `lambert`; every other glTF file
+    /// with `pbr`, glTF's metallic-roughness model).
+    #[arg(long, value_enum, default_value_t = ShadingArg::Auto)]
+    pub shading: ShadingArg,
+    /// Image-based light of PBR scenes: `studio` (built-in), `none`, or an equirectangular
+    /// .hdr or .exr image. Default: the studio when the file has no lights, else none.
+    #[arg(long, value_name = "FILE|studio|none")]
+    pub environment: Option<String>,
+    /// Multiplies the environment's light.
+    #[arg(long, value_name = "SCALE", default_value_t = 1.0, value_parser = parse_non_negative)]
+    pub environment_intensity: f32,
+    /// Turns the environment about the up axis (+Y), in degrees.
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_finite)]
+    pub environment_rotation: f32,
+    /// Exposure of PBR scenes in stops (colour × 2^EV before the tone map).
+    #[arg(long, value_name = "EV", default_value_t = 0.0, allow_hyphen_values = true, value_parser = parse_finite)]
+    pub exposure: f32,
+    /// Tone map of PBR scenes.
+    #[arg(long, value_enum, default_value_t = TonemapArg::PbrNeutral)]
+    pub tonemap: TonemapArg,
+}
+
+/// `--shading`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ShadingArg {
+    /// By the file (see `--shading`).
+    Auto,
+    /// The reference scenes' Lambert model.
+    Lambert,
+    /// glTF's metallic-roughness model with punctual lights and image-based light.
+    Pbr,
+}
+
+/// `--tonemap`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum TonemapArg {
+    /// Colours as they are (above 1 clips).
+    None,
+    /// Khronos PBR Neutral (for product pictures).
+    PbrNeutral,
+    /// The ACES filmic curve (Narkowicz's fit).
+    Aces,
+}
+
+/// Parses a finite number.
+fn parse_finite(s: &str) -> Result<f32, String> {
+    s.trim()
+        .parse::<f32>()
+        .ok()
+        .filter(|v| v.is_finite())
+        .ok_or_else(|| format!("'{s}' is not a finite number"))
+}
+
+/// Parses a finite number ≥ 0.
+fn parse_non_negative(s: &str) -> Result<f32, String> {
+    parse_finite(s)
+        .ok()
+        .filter(|v| *v >= 0.0)
+        .ok_or_else(|| format!("'{s}' is not a finite number ≥ 0"))
 }
 
 /// Parses a byte count with an optional K, M, G or T suffix (powers of 1024).

@@ -4,9 +4,11 @@ use std::collections::HashSet;
 use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
-use kantele_scene::{LoadOptions, LoadedScene};
+use kantele::scene::Shading;
+use kantele::shade::pbr::Tonemap;
+use kantele_scene::{EnvironmentChoice, LoadOptions, LoadedScene};
 
-use crate::cli::SceneArgs;
+use crate::cli::{SceneArgs, ShadingArg, TonemapArg};
 
 /// One scene to load.
 #[derive(Clone, Debug)]
@@ -118,6 +120,31 @@ pub fn inputs(args: &SceneArgs) -> Result<Vec<Input>> {
         max_memory: args.max_memory.unwrap_or(kantele_scene::DEFAULT_MAX_MEMORY),
         allow_read: args.allow_read.clone(),
         strict: args.strict,
+        shading: match args.shading {
+            ShadingArg::Auto => None,
+            ShadingArg::Lambert => Some(Shading::Lambert),
+            ShadingArg::Pbr => Some(Shading::Pbr),
+        },
+        environment: match args.environment.as_deref() {
+            None => EnvironmentChoice::Default,
+            Some("studio") => EnvironmentChoice::Studio,
+            Some("none") => EnvironmentChoice::None,
+            Some(file) => {
+                let path = PathBuf::from(file);
+                if !path.is_file() {
+                    bail!("--environment {file}: no such file (or use studio, none)");
+                }
+                EnvironmentChoice::File(path)
+            }
+        },
+        environment_intensity: args.environment_intensity,
+        environment_rotation_degrees: args.environment_rotation,
+        exposure: args.exposure,
+        tonemap: match args.tonemap {
+            TonemapArg::None => Tonemap::None,
+            TonemapArg::PbrNeutral => Tonemap::PbrNeutral,
+            TonemapArg::Aces => Tonemap::Aces,
+        },
         ..LoadOptions::default()
     };
     let file = |p: PathBuf| Input::File(p, options.clone());

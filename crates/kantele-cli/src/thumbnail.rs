@@ -22,6 +22,12 @@ pub fn run(args: &ThumbnailArgs) -> Result<()> {
         strict: false,
         max_memory: None,
         allow_read: Vec::new(),
+        shading: crate::cli::ShadingArg::Auto,
+        environment: None,
+        environment_intensity: 1.0,
+        environment_rotation: 0.0,
+        exposure: 0.0,
+        tonemap: crate::cli::TonemapArg::PbrNeutral,
     })?;
     if found.len() != 1 {
         anyhow::bail!(

@@ -20,6 +20,7 @@ pub mod cpu;
 #[doc(hidden)]
 pub mod fuzz_targets;
 pub mod material;
+pub mod pbr_material;
 pub mod pipeline;
 pub mod raster;
 pub mod rop;

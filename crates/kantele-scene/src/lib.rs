@@ -35,13 +35,15 @@
 
 use std::path::{Path, PathBuf};
 
-use kantele_rules::scene::Scene;
+use kantele_rules::scene::{Scene, Shading};
+use kantele_rules::shade::pbr::Tonemap;
 use thiserror::Error;
 
 mod accessor;
 mod budget;
 mod builtin;
 mod ear_clip;
+mod environment_file;
 mod gltf_loader;
 mod gltf_patch;
 pub mod mesh_util;
@@ -51,6 +53,7 @@ mod obj_text;
 mod obj_wide;
 mod quiet_panic;
 mod read_policy;
+mod shading;
 pub mod texture_util;
 mod uri;
 
@@ -188,6 +191,34 @@ pub struct LoadOptions {
     /// Decode textures (default). Without it, each image's header is read and a placeholder of
     /// its size stands in for it: for describing a scene without paying for its pixels.
     pub decode_textures: bool,
+    /// The shading model; `None` (default) lets the file decide: glTF reference scenes (whose
+    /// `scene.extras` carry `ambient`), OBJ files and built-in scenes are drawn with
+    /// [`Shading::Lambert`], every other glTF file with [`Shading::Pbr`].
+    pub shading: Option<Shading>,
+    /// Image-based light of PBR scenes.
+    pub environment: EnvironmentChoice,
+    /// Multiplies the environment's light.
+    pub environment_intensity: f32,
+    /// Turns the environment about world +Y, in degrees.
+    pub environment_rotation_degrees: f32,
+    /// Exposure of PBR scenes in stops.
+    pub exposure: f32,
+    /// Tone map of PBR scenes.
+    pub tonemap: Tonemap,
+}
+
+/// Which environment lights a PBR scene.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub enum EnvironmentChoice {
+    /// The built-in studio when the file has no lights, else none.
+    #[default]
+    Default,
+    /// The built-in neutral studio ([`kantele_rules::shade::environment::EnvironmentLight::studio`]).
+    Studio,
+    /// No environment: the file's lights, or a headlight when it has none.
+    None,
+    /// An equirectangular `.hdr` or `.exr` image (read wherever it is: the user named it).
+    File(PathBuf),
 }
 
 impl Default for LoadOptions {
@@ -197,6 +228,12 @@ impl Default for LoadOptions {
             allow_read: Vec::new(),
             strict: false,
             decode_textures: true,
+            shading: None,
+            environment: EnvironmentChoice::Default,
+            environment_intensity: 1.0,
+            environment_rotation_degrees: 0.0,
+            exposure: 0.0,
+            tonemap: Tonemap::PbrNeutral,
         }
     }
 }

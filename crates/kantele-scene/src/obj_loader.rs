@@ -170,6 +170,13 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
             double_sided: false,
             alpha_mode,
             unlit: false,
+            // For PBR shading: a dielectric whose roughness follows the specular exponent
+            // (`Ns`, Blender's conversion `√(2 / (Ns + 2))`), fully rough without one.
+            metallic: 0.0,
+            roughness: m
+                .shininess
+                .filter(|s| s.is_finite() && *s >= 0.0)
+                .map_or(1.0, |s| (2.0 / (s + 2.0)).sqrt()),
             ..Material::default()
         });
     }
@@ -284,6 +291,15 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     scene
         .validate()
         .map_err(|e| LoadError::invalid(path, e.to_string()))?;
+    crate::shading::apply(
+        &mut scene,
+        &mut info,
+        options,
+        kantele_rules::scene::Shading::Lambert,
+        false,
+        &mut budget,
+    )
+    .map_err(|e| LoadError::invalid(path, e))?;
     Ok(LoadedScene { scene, info })
 }
 

@@ -57,6 +57,17 @@ pub(crate) fn decode_srgb_within(
     mime_type: Option<&str>,
     budget: &mut Budget,
 ) -> Result<Texture, ImageError> {
+    decode_within(bytes, mime_type, ColorSpace::Srgb, budget)
+}
+
+/// [`decode_srgb_within`] for a texture whose texels are encoded in `color_space` (linear for
+/// data such as normals, metallic-roughness and occlusion).
+pub(crate) fn decode_within(
+    bytes: &[u8],
+    mime_type: Option<&str>,
+    color_space: ColorSpace,
+    budget: &mut Budget,
+) -> Result<Texture, ImageError> {
     let (width, height) = image_size(bytes, mime_type)?;
     let max = kantele_rules::shade::texture::MAX_TEXTURE_SIZE;
     if width == 0 || height == 0 || width > max || height > max {
@@ -83,7 +94,7 @@ pub(crate) fn decode_srgb_within(
         .map_err(|e| ImageError::Decode(format!("cannot decode image: {e}")))?;
     let rgba = decoded.to_rgba8();
     drop(decoded);
-    Texture::from_rgba8(rgba.width(), rgba.height(), rgba.as_raw(), ColorSpace::Srgb)
+    Texture::from_rgba8(rgba.width(), rgba.height(), rgba.as_raw(), color_space)
         .map_err(|e| ImageError::Decode(e.to_string()))
 }
 

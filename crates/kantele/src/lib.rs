@@ -88,4 +88,4 @@ pub use kantele_rules::reference;
 /// Bodies of the fuzz targets in `fuzz/`, callable from stable tests (not a public API).
 #[doc(hidden)]
 pub use kantele_cpu::fuzz_targets;
-pub use kantele_cpu::{band, cpu, material, pipeline, raster, rop};
+pub use kantele_cpu::{band, cpu, material, pbr_material, pipeline, raster, rop};

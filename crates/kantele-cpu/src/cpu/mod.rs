@@ -4,13 +4,15 @@
 use std::sync::Arc;
 
 use crate::material::{Lighting, MaterialShader, StandardVertex};
+use crate::pbr_material::{PbrShader, PbrTextures};
 use crate::pipeline::{Indices, RenderState, Renderer, RendererOptions};
 use crate::raster::Strategy;
 use crate::rop::TargetFormat;
 use kantele_rules::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele_rules::error::RenderError;
 use kantele_rules::multisample::SampleCount;
-use kantele_rules::scene::{Mesh, Scene, Topology};
+use kantele_rules::scene::{Mesh, Scene, Shading, Topology};
+use kantele_rules::shade::pbr::PbrLighting;
 use kantele_rules::stats::FrameStats;
 
 /// Options of the CPU backend.
@@ -82,6 +84,67 @@ impl CpuBackend {
     /// The underlying renderer (framebuffer access).
     pub fn renderer(&self) -> &Renderer {
         &self.renderer
+    }
+}
+
+impl CpuBackend {
+    /// A frame of a [`Shading::Pbr`] scene (the renderer already sized for `view`).
+    fn render_pbr(&mut self, view: &FrameView) -> Result<FrameStats, RenderError> {
+        let Some((scene, meshes)) = &self.scene else {
+            return Err(RenderError::InvalidScene("no scene loaded".into()));
+        };
+        let view_projection = view.projection * view.view;
+        let lighting = PbrLighting::for_frame(scene, view);
+        let unlit = scene.unlit_materials();
+        let bound = |b: Option<kantele_rules::scene::TextureBinding>| {
+            b.map(|b| (&*scene.textures[b.texture], b.sampler))
+        };
+        let shaders: Vec<PbrShader<'_>> = scene
+            .draws
+            .iter()
+            .enumerate()
+            .map(|(i, draw)| {
+                let material = scene.draw_material(draw.mesh, &unlit);
+                let textures = PbrTextures {
+                    base_color: bound(material.base_color_texture),
+                    emissive: bound(material.emissive_texture),
+                    metallic_roughness: bound(material.metallic_roughness_texture),
+                    normal: bound(material.normal_texture),
+                    occlusion: bound(material.occlusion_texture),
+                };
+                PbrShader::new(
+                    draw.model,
+                    view_projection,
+                    &lighting,
+                    material,
+                    textures,
+                    view.pass,
+                    (draw.node_index as u32 + 1, i as u32 + 1),
+                )
+                .with_vertex_colors(scene.meshes[draw.mesh].colors.is_some())
+            })
+            .collect();
+        let clear = match view.pass {
+            Pass::Color => scene.clear_color,
+            Pass::Normals | Pass::Ids => glam::Vec4::ZERO,
+        };
+        let mut frame = self.renderer.begin_frame(Some(clear), Some(1.0));
+        for index in scene.draw_order(&view.view) {
+            let (draw, shader) = (&scene.draws[index], &shaders[index]);
+            let mesh = &meshes[draw.mesh];
+            let state = RenderState {
+                front_face: draw.front_face(),
+                ..shader.render_state()
+            };
+            frame.draw_primitives(
+                shader,
+                &mesh.vertices,
+                Indices::U32(&mesh.indices),
+                mesh.topology,
+                state,
+            )?;
+        }
+        frame.try_end()
     }
 }
 
@@ -164,6 +227,9 @@ impl Backend for CpuBackend {
             light_color: view.light_color,
             ambient: scene.ambient,
         };
+        if scene.shading == Shading::Pbr {
+            return self.render_pbr(view);
+        }
         let unlit = scene.unlit_materials();
         let shaders: Vec<MaterialShader<'_>> = scene
             .draws

@@ -223,6 +223,11 @@ impl Backend for CudaBackend {
 
     fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError> {
         scene.validate()?;
+        if scene.shading == kantele_rules::scene::Shading::Pbr {
+            return Err(unsupported(
+                "PBR shading is not implemented in the CUDA kernels yet; draw the file with --shading lambert, or with the cpu or gl backend".to_string(),
+            ));
+        }
         let arrays = SceneArrays::new(&scene).map_err(|e| unsupported(e.to_string()))?;
         self.stream
             .synchronize()

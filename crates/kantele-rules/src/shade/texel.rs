@@ -13,7 +13,7 @@ use glam::Vec4;
 use crate::color::{encode_rgba8, srgb_to_linear};
 
 /// How the 8-bit channels of an image are encoded.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum ColorSpace {
     /// Values are linear intensities.
     Linear,

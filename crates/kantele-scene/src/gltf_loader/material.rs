@@ -9,7 +9,8 @@ use kantele_rules::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 
 use super::{named, Loader};
 use crate::accessor::BufferData;
-use crate::texture_util::{decode_srgb_within, image_size, placeholder, ImageError};
+use crate::texture_util::{decode_within, image_size, placeholder, ImageError};
+use kantele_rules::shade::texture::ColorSpace;
 use crate::uri::read_uri;
 use crate::LoadError;
 
@@ -24,10 +25,12 @@ pub(super) struct UvMap {
 }
 
 impl UvMap {
-    fn of(info: &gltf::texture::Info) -> Self {
-        let mut set = info.tex_coord();
+    /// The map of a texture reference: its `texCoord` and its `KHR_texture_transform`
+    /// extension value, if any.
+    fn of(tex_coord: u32, texture_transform: Option<&serde_json::Value>) -> Self {
+        let mut set = tex_coord;
         let mut transform = Mat3::IDENTITY;
-        if let Some(t) = info.extension_value("KHR_texture_transform") {
+        if let Some(t) = texture_transform {
             let pair = |key: &str, default: Vec2| {
                 t.get(key)
                     .and_then(|v| v.as_array())
@@ -62,16 +65,72 @@ impl UvMap {
     }
 }
 
+/// Which of a material's textures.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum TextureSlot {
+    BaseColor,
+    Emissive,
+    MetallicRoughness,
+    Normal,
+    Occlusion,
+}
+
+impl TextureSlot {
+    fn name(self) -> &'static str {
+        match self {
+            TextureSlot::BaseColor => "base colour",
+            TextureSlot::Emissive => "emissive",
+            TextureSlot::MetallicRoughness => "metallic-roughness",
+            TextureSlot::Normal => "normal",
+            TextureSlot::Occlusion => "occlusion",
+        }
+    }
+}
+
+/// The name of the texture whose coordinates a material's meshes carry: the first one bound.
+fn refs_first_name(material: &Material) -> &'static str {
+    if material.base_color_texture.is_some() {
+        TextureSlot::BaseColor.name()
+    } else if material.emissive_texture.is_some() {
+        TextureSlot::Emissive.name()
+    } else if material.metallic_roughness_texture.is_some() {
+        TextureSlot::MetallicRoughness.name()
+    } else if material.normal_texture.is_some() {
+        TextureSlot::Normal.name()
+    } else {
+        "first"
+    }
+}
+
 impl Loader<'_> {
     /// Converts a material; also records which texture coordinates its textures read
     /// (`self.material_uv`), which the loader bakes into the meshes that use it.
     pub(super) fn material(&mut self, material: &gltf::Material) -> Result<Material, LoadError> {
         let name = named(material.name(), "material", material.index().unwrap_or(0));
         let pbr = material.pbr_metallic_roughness();
-        let (base_color_texture, base_uv) = match pbr.base_color_texture() {
-            Some(info) => (self.texture_binding(&info)?, Some(UvMap::of(&info))),
-            None => (None, None),
-        };
+        let transform = "KHR_texture_transform";
+        // Every texture of the material, with its colour space and the coordinates it reads.
+        let mut refs: Vec<(TextureSlot, gltf::texture::Texture, ColorSpace, UvMap)> = Vec::new();
+        if let Some(info) = pbr.base_color_texture() {
+            let uv = UvMap::of(info.tex_coord(), info.extension_value(transform));
+            refs.push((TextureSlot::BaseColor, info.texture(), ColorSpace::Srgb, uv));
+        }
+        if let Some(info) = material.emissive_texture() {
+            let uv = UvMap::of(info.tex_coord(), info.extension_value(transform));
+            refs.push((TextureSlot::Emissive, info.texture(), ColorSpace::Srgb, uv));
+        }
+        if let Some(info) = pbr.metallic_roughness_texture() {
+            let uv = UvMap::of(info.tex_coord(), info.extension_value(transform));
+            refs.push((TextureSlot::MetallicRoughness, info.texture(), ColorSpace::Linear, uv));
+        }
+        if let Some(t) = material.normal_texture() {
+            let uv = UvMap::of(t.tex_coord(), t.extension_value(transform));
+            refs.push((TextureSlot::Normal, t.texture(), ColorSpace::Linear, uv));
+        }
+        if let Some(t) = material.occlusion_texture() {
+            let uv = UvMap::of(t.tex_coord(), t.extension_value(transform));
+            refs.push((TextureSlot::Occlusion, t.texture(), ColorSpace::Linear, uv));
+        }
         let strength = material
             .extension_value("KHR_materials_emissive_strength")
             .and_then(|v| v.get("emissiveStrength"))
@@ -82,26 +141,58 @@ impl Loader<'_> {
         if !emissive.is_finite() {
             emissive = Vec3::ZERO;
         }
-        let (mut emissive_texture, emissive_uv) = match material.emissive_texture() {
-            Some(info) => (self.texture_binding(&info)?, Some(UvMap::of(&info))),
-            None => (None, None),
+        let finite_or = |v: f32, default: f32| if v.is_finite() { v } else { default };
+        let mut out = Material {
+            name: material.name().unwrap_or_default().to_string(),
+            base_color_factor: Vec4::from(pbr.base_color_factor()),
+            double_sided: material.double_sided(),
+            unlit: material.unlit(),
+            emissive,
+            metallic: finite_or(pbr.metallic_factor(), 1.0).clamp(0.0, 1.0),
+            roughness: finite_or(pbr.roughness_factor(), 1.0).clamp(0.0, 1.0),
+            normal_scale: material
+                .normal_texture()
+                .map_or(1.0, |t| finite_or(t.scale(), 1.0)),
+            occlusion_strength: material
+                .occlusion_texture()
+                .map_or(1.0, |t| finite_or(t.strength(), 1.0).clamp(0.0, 1.0)),
+            ..Material::default()
         };
-        let mut uv = base_color_texture.and(base_uv);
-        if emissive_texture.is_some() {
+        // The meshes carry one set of texture coordinates per material: the first texture's
+        // (the base colour's when it has one). A texture reading other coordinates is left out.
+        let mut uv = None;
+        for (slot, texture, color_space, map) in refs {
+            if material.unlit() && slot != TextureSlot::BaseColor {
+                // KHR_materials_unlit: every property but the base colour is a fallback for
+                // viewers without the extension.
+                continue;
+            }
             match uv {
-                None => uv = emissive_uv,
-                Some(base) if Some(base) != emissive_uv => {
+                None => uv = Some(map),
+                Some(first) if first != map => {
                     self.info.warn(format!(
-                        "material '{name}': the emissive texture reads other texture coordinates than the base colour texture; its emission is left out"
+                        "material '{name}': the {} texture reads other texture coordinates than the {} texture; it is left out",
+                        slot.name(),
+                        refs_first_name(&out),
                     ));
-                    emissive_texture = None;
-                    emissive = Vec3::ZERO;
+                    if slot == TextureSlot::Emissive {
+                        out.emissive = Vec3::ZERO;
+                    }
+                    continue;
                 }
                 Some(_) => {}
             }
+            let binding = self.texture_binding(&texture, color_space)?;
+            match slot {
+                TextureSlot::BaseColor => out.base_color_texture = binding,
+                TextureSlot::Emissive => out.emissive_texture = binding,
+                TextureSlot::MetallicRoughness => out.metallic_roughness_texture = binding,
+                TextureSlot::Normal => out.normal_texture = binding,
+                TextureSlot::Occlusion => out.occlusion_texture = binding,
+            }
         }
         self.material_uv.push(uv);
-        let alpha_mode = match material.alpha_mode() {
+        out.alpha_mode = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => AlphaMode::Mask {
                 cutoff: material.alpha_cutoff().unwrap_or(0.5),
@@ -109,28 +200,17 @@ impl Loader<'_> {
             gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         };
         if material.unlit() {
-            // KHR_materials_unlit: every property but the base colour is a fallback for viewers
-            // without the extension; the unlit shading adds emission, so drop it here.
-            emissive = Vec3::ZERO;
-            emissive_texture = None;
+            // The unlit shading adds emission: drop the fallback's.
+            out.emissive = Vec3::ZERO;
         }
-        Ok(Material {
-            name: material.name().unwrap_or_default().to_string(),
-            base_color_factor: Vec4::from(pbr.base_color_factor()),
-            base_color_texture,
-            double_sided: material.double_sided(),
-            alpha_mode,
-            unlit: material.unlit(),
-            emissive,
-            emissive_texture,
-        })
+        Ok(out)
     }
 
     fn texture_binding(
         &mut self,
-        info: &gltf::texture::Info,
+        texture: &gltf::texture::Texture,
+        color_space: ColorSpace,
     ) -> Result<Option<TextureBinding>, LoadError> {
-        let texture = info.texture();
         let Some(image_index) = self
             .patched
             .texture_images
@@ -140,11 +220,11 @@ impl Loader<'_> {
         else {
             return Ok(None);
         };
-        let texture_index = match self.image_textures.get(&image_index) {
+        let texture_index = match self.image_textures.get(&(image_index, color_space)) {
             Some(&t) => t,
             None => {
-                let t = self.image(image_index)?;
-                self.image_textures.insert(image_index, t);
+                let t = self.image(image_index, color_space)?;
+                self.image_textures.insert((image_index, color_space), t);
                 t
             }
         };
@@ -187,10 +267,10 @@ impl Loader<'_> {
         }))
     }
 
-    /// Loads one glTF image as an sRGB texture into the scene (once per distinct encoded
-    /// image); `None` when it is missing or cannot be decoded and the load is not strict (a
-    /// warning says so). Budget overruns are always errors.
-    fn image(&mut self, index: usize) -> Result<Option<usize>, LoadError> {
+    /// Loads one glTF image as a texture of `color_space` into the scene (once per distinct
+    /// encoded image and colour space); `None` when it is missing or cannot be decoded and the
+    /// load is not strict (a warning says so). Budget overruns are always errors.
+    fn image(&mut self, index: usize, color_space: ColorSpace) -> Result<Option<usize>, LoadError> {
         let Some(image) = self.document.images().nth(index) else {
             return Ok(None);
         };
@@ -222,9 +302,11 @@ impl Loader<'_> {
             }
             Err(e) => return self.texture_problem(format!("{what}: {e}")),
         };
-        if let Some(&t) = self.encoded_images.get(&bytes) {
+        let key = (bytes, color_space);
+        if let Some(&t) = self.encoded_images.get(&key) {
             return Ok(Some(t));
         }
+        let bytes = key.0;
         let size = match image_size(&bytes, mime_type.as_deref()) {
             Ok(size) => size,
             Err(ImageError::Budget(e) | ImageError::Decode(e)) => {
@@ -233,16 +315,21 @@ impl Loader<'_> {
         };
         if !self.options.decode_textures {
             // Describing the scene: the header's size is reported, nothing is decoded.
-            return Ok(Some(self.push_texture(placeholder(), bytes, size)));
+            return Ok(Some(self.push_texture(placeholder(), (bytes, color_space), size)));
         }
-        match decode_srgb_within(&bytes, mime_type.as_deref(), &mut self.budget) {
-            Ok(texture) => Ok(Some(self.push_texture(texture, bytes, size))),
+        match decode_within(&bytes, mime_type.as_deref(), color_space, &mut self.budget) {
+            Ok(texture) => Ok(Some(self.push_texture(texture, (bytes, color_space), size))),
             Err(ImageError::Budget(e)) => Err(self.invalid(format!("{what}: {e}"))),
             Err(ImageError::Decode(e)) => self.texture_problem(format!("{what}: {e}")),
         }
     }
 
-    fn push_texture(&mut self, texture: Texture, encoded: Vec<u8>, size: (u32, u32)) -> usize {
+    fn push_texture(
+        &mut self,
+        texture: Texture,
+        encoded: (Vec<u8>, ColorSpace),
+        size: (u32, u32),
+    ) -> usize {
         self.scene.textures.push(Arc::new(texture));
         self.info.texture_sizes.push(size);
         let t = self.scene.textures.len() - 1;

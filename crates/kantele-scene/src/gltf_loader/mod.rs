@@ -9,6 +9,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use kantele_rules::scene::Scene;
+use kantele_rules::shade::texture::ColorSpace;
 
 use crate::budget::Budget;
 use crate::gltf_patch::{patch, split_glb, Patched};
@@ -96,6 +97,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         primitive_meshes: HashMap::new(),
         default_material: None,
         material_uv: Vec::new(),
+        reference_extras: false,
+        clear_color_given: false,
     }
     .run()
 }
@@ -232,9 +235,9 @@ struct Loader<'a> {
     scene: Scene,
     info: SceneInfo,
     /// glTF image index → index into `scene.textures` (`None`: it could not be loaded).
-    image_textures: HashMap<usize, Option<usize>>,
+    image_textures: HashMap<(usize, ColorSpace), Option<usize>>,
     /// Encoded image bytes → index into `scene.textures`: identical sources decode once.
-    encoded_images: HashMap<Vec<u8>, usize>,
+    encoded_images: HashMap<(Vec<u8>, ColorSpace), usize>,
     /// (glTF mesh, primitive, morph weights' bits) → index into `scene.meshes` (`None`: not
     /// drawable, skipped).
     primitive_meshes: HashMap<(usize, usize, Vec<u32>), Option<usize>>,
@@ -242,6 +245,10 @@ struct Loader<'a> {
     default_material: Option<usize>,
     /// Per file material: the texture coordinates its textures read.
     material_uv: Vec<Option<UvMap>>,
+    /// The scene's extras carry `ambient`: a reference scene (Lambert by default).
+    reference_extras: bool,
+    /// The scene's extras give a clear colour.
+    clear_color_given: bool,
 }
 
 impl Loader<'_> {

@@ -2,7 +2,7 @@
 //! (`EXT_mesh_gpu_instancing`) and the scene's extras.
 
 use glam::{Mat4, Quat, Vec3, Vec4};
-use kantele_rules::scene::{Draw, Light, NamedCamera};
+use kantele_rules::scene::{Draw, Light, LightKind, NamedCamera, PunctualLight, Shading};
 
 use super::{named, Loader, DEFAULT_RESOLUTION};
 use crate::accessor::{read_f32, BufferData};
@@ -76,16 +76,40 @@ impl Loader<'_> {
                 }
             }
             if let Some(l) = node.light() {
-                match l.kind() {
+                let color = Vec3::from(l.color()) * l.intensity();
+                let kind = match l.kind() {
                     gltf::khr_lights_punctual::Kind::Directional => {
                         if light.is_none() {
                             light = Some(Light::Directional {
                                 to_light: world.transform_vector3(Vec3::Z).normalize_or_zero(),
-                                color: Vec3::from(l.color()) * l.intensity(),
+                                color,
                             });
                         }
+                        LightKind::Directional
                     }
-                    _ => self.info.ignore("point and spot lights"),
+                    gltf::khr_lights_punctual::Kind::Point => LightKind::Point,
+                    gltf::khr_lights_punctual::Kind::Spot {
+                        inner_cone_angle,
+                        outer_cone_angle,
+                    } => LightKind::Spot {
+                        inner_cone_angle,
+                        outer_cone_angle,
+                    },
+                };
+                let punctual = PunctualLight {
+                    kind,
+                    color,
+                    position: world.transform_point3(Vec3::ZERO),
+                    direction: world.transform_vector3(Vec3::NEG_Z).normalize_or_zero(),
+                    range: l.range(),
+                };
+                if punctual.color.is_finite() && punctual.position.is_finite() {
+                    self.scene.lights.push(punctual);
+                } else {
+                    self.info.warn(format!(
+                        "light '{}' has a non-finite colour or position; left out",
+                        named(l.name(), "light", l.index())
+                    ));
                 }
             }
             if let Some(mesh) = node.mesh() {
@@ -135,6 +159,7 @@ impl Loader<'_> {
         }
 
         self.scene.light = light.unwrap_or(Light::Headlight);
+        self.choose_shading()?;
         match camera {
             Some(camera) => {
                 self.scene.camera = camera;
@@ -226,6 +251,25 @@ impl Loader<'_> {
         Ok(models)
     }
 
+    /// Decides the shading model (see [`crate::LoadOptions::shading`]) and sets up what goes
+    /// with it ([`crate::shading::apply`]).
+    fn choose_shading(&mut self) -> Result<(), LoadError> {
+        let default = if self.reference_extras {
+            Shading::Lambert
+        } else {
+            Shading::Pbr
+        };
+        crate::shading::apply(
+            &mut self.scene,
+            &mut self.info,
+            self.options,
+            default,
+            self.clear_color_given,
+            &mut self.budget,
+        )
+        .map_err(|e| self.invalid(e))
+    }
+
     /// Reads `resolution`, `clear_color` and `ambient` from the scene's extras.
     fn extras(&mut self, gltf_scene: &gltf::Scene) {
         self.scene.resolution = DEFAULT_RESOLUTION;
@@ -265,9 +309,11 @@ impl Loader<'_> {
             match numbers(v).as_deref() {
                 Some(&[r, g, b, a]) if [r, g, b, a].iter().all(|c| c.is_finite()) => {
                     self.scene.clear_color = Vec4::new(r as f32, g as f32, b as f32, a as f32);
+                    self.clear_color_given = true;
                 }
                 Some(&[r, g, b]) if [r, g, b].iter().all(|c| c.is_finite()) => {
                     self.scene.clear_color = Vec4::new(r as f32, g as f32, b as f32, 1.0);
+                    self.clear_color_given = true;
                 }
                 _ => self.info.warn(format!(
                     "scene extras: clear_color {v} is not [r, g, b, a]; using black"
@@ -275,6 +321,7 @@ impl Loader<'_> {
             }
         }
         if let Some(v) = value.get("ambient") {
+            self.reference_extras = true;
             match v.as_f64() {
                 Some(a) if a.is_finite() => self.scene.ambient = a as f32,
                 _ => self.info.warn(format!(

@@ -1,0 +1,461 @@
+//! The built-in PBR material: glTF 2.0's metallic-roughness model
+//! ([`kantele_rules::shade::pbr`]) as a [`Shader`] of the CPU pipeline, for scenes drawn with
+//! [`Shading::Pbr`](kantele_rules::scene::Shading::Pbr).
+//!
+//! Per fragment: the base colour, alpha and emission as the Lambert material reads them; metallic
+//! and roughness (× the blue and green channels of their texture), occlusion, and the shading
+//! normal — the interpolated world normal, bent by the normal texture in the tangent frame
+//! derived from the screen-space derivatives of the world position and the texture coordinate
+//! (as the glTF sample viewer does for meshes without tangents); then
+//! [`pbr::shade`](kantele_rules::shade::pbr::shade), emission, exposure and the tone map.
+//!
+//! One generic routine shades eight fragments at once ([`FragmentLanes`]) and one fragment
+//! ([`Fragment`], every lane holding it), so both follow the same operations.
+
+use glam::{Mat3, Mat4, Vec2, Vec4};
+
+use crate::material::StandardVertex;
+use crate::pipeline::{Fragment, FragmentLanes, RenderState, ShadedLanes, Shader};
+use crate::rop::BlendMode;
+use kantele_lanes::{F32x8, Lanes, Mask8, Scalar};
+use kantele_rules::backend::Pass;
+use kantele_rules::camera::normal_matrix;
+use kantele_rules::scene::{AlphaMode, Material};
+use kantele_rules::setup::CullMode;
+use kantele_rules::shade::pbr::{self, normalize3, PbrLighting, Surface};
+use kantele_rules::shade::texture::{Sampler, Texture};
+
+/// Where the PBR shader's varyings sit.
+mod at {
+    /// World normal, three.
+    pub const NORMAL: usize = 0;
+    /// World position, three.
+    pub const POSITION: usize = 3;
+    /// Texture coordinate, two.
+    pub const TEXCOORD: usize = 6;
+    /// Vertex colour, four.
+    pub const COLOR: usize = 8;
+}
+
+/// A texture with the sampler it is read through.
+pub type BoundTexture<'a> = Option<(&'a Texture, Sampler)>;
+
+/// The textures a PBR material reads.
+#[derive(Clone, Copy, Default)]
+pub struct PbrTextures<'a> {
+    /// sRGB base colour.
+    pub base_color: BoundTexture<'a>,
+    /// sRGB emission.
+    pub emissive: BoundTexture<'a>,
+    /// Linear: blue = metallic, green = roughness.
+    pub metallic_roughness: BoundTexture<'a>,
+    /// Linear tangent-space normal.
+    pub normal: BoundTexture<'a>,
+    /// Linear: red = occlusion.
+    pub occlusion: BoundTexture<'a>,
+}
+
+impl PbrTextures<'_> {
+    fn any(&self) -> bool {
+        self.base_color.is_some()
+            || self.emissive.is_some()
+            || self.metallic_roughness.is_some()
+            || self.normal.is_some()
+            || self.occlusion.is_some()
+    }
+}
+
+/// The shader of one draw of a PBR scene.
+pub struct PbrShader<'a> {
+    model: Mat4,
+    model_view_projection: Mat4,
+    normal_matrix: Mat3,
+    lighting: &'a PbrLighting,
+    material: &'a Material,
+    textures: PbrTextures<'a>,
+    pass: Pass,
+    /// `(instance id, draw id)` for the id pass.
+    ids: (f32, f32),
+    /// The mesh has vertex colours.
+    vertex_colors: bool,
+}
+
+impl<'a> PbrShader<'a> {
+    /// The shader for a draw with object → world `model`, seen through `view_projection`, lit
+    /// by the frame's `lighting`. `ids` are the instance id and draw id of the id pass.
+    pub fn new(
+        model: Mat4,
+        view_projection: Mat4,
+        lighting: &'a PbrLighting,
+        material: &'a Material,
+        textures: PbrTextures<'a>,
+        pass: Pass,
+        ids: (u32, u32),
+    ) -> Self {
+        Self {
+            model,
+            model_view_projection: view_projection * model,
+            normal_matrix: normal_matrix(&model),
+            lighting,
+            material,
+            textures,
+            pass,
+            ids: (ids.0 as f32, ids.1 as f32),
+            vertex_colors: true,
+        }
+    }
+
+    /// Whether the mesh has vertex colours (glTF `COLOR_0`; the default is yes).
+    pub fn with_vertex_colors(mut self, present: bool) -> Self {
+        self.vertex_colors = present;
+        self
+    }
+
+    /// Culling unless double-sided; alpha blending without depth writes for BLEND (colour pass).
+    pub fn render_state(&self) -> RenderState {
+        let blend = matches!(self.material.alpha_mode, AlphaMode::Blend);
+        RenderState {
+            cull: if self.material.double_sided {
+                CullMode::None
+            } else {
+                CullMode::Back
+            },
+            depth_write: !blend,
+            blend: if blend && self.pass == Pass::Color {
+                BlendMode::Alpha
+            } else {
+                BlendMode::Replace
+            },
+            ..RenderState::default()
+        }
+    }
+
+    fn varying_count(&self) -> usize {
+        if self.vertex_colors {
+            at::COLOR + 4
+        } else if self.textures.any() {
+            at::TEXCOORD + 2
+        } else {
+            at::POSITION + 3
+        }
+    }
+}
+
+/// What the shading routine reads of the fragments it shades: varyings, their derivatives and
+/// texture samples, for eight fragments ([`FragmentLanes`]) or one ([`Fragment`] in every lane).
+trait Fragments<L: Lanes> {
+    fn lanes(&self) -> L;
+    fn varying(&self, index: usize) -> L::F32;
+    fn derivatives(&self, index: usize) -> (L::F32, L::F32);
+    fn sample(&self, texture: &Texture, sampler: &Sampler) -> [L::F32; 4];
+    fn front_facing(&self) -> bool;
+    fn primitive_id(&self) -> u32;
+}
+
+impl<L: Lanes> Fragments<L> for FragmentLanes<'_, L> {
+    #[inline(always)]
+    fn lanes(&self) -> L {
+        self.lanes
+    }
+    #[inline(always)]
+    fn varying(&self, index: usize) -> L::F32 {
+        FragmentLanes::varying(self, index)
+    }
+    #[inline(always)]
+    fn derivatives(&self, index: usize) -> (L::F32, L::F32) {
+        FragmentLanes::derivatives(self, index)
+    }
+    #[inline(always)]
+    fn sample(&self, texture: &Texture, sampler: &Sampler) -> [L::F32; 4] {
+        let u = at::TEXCOORD;
+        let (du_dx, du_dy) = FragmentLanes::derivatives(self, u);
+        let (dv_dx, dv_dy) = FragmentLanes::derivatives(self, u + 1);
+        texture.sample_grad_lanes::<L>(
+            sampler,
+            [FragmentLanes::varying(self, u), FragmentLanes::varying(self, u + 1)],
+            [du_dx, dv_dx],
+            [du_dy, dv_dy],
+            self.active,
+        )
+    }
+    #[inline(always)]
+    fn front_facing(&self) -> bool {
+        self.front_facing
+    }
+    #[inline(always)]
+    fn primitive_id(&self) -> u32 {
+        self.primitive_id
+    }
+}
+
+impl Fragments<Scalar> for Fragment<'_> {
+    fn lanes(&self) -> Scalar {
+        Scalar
+    }
+    fn varying(&self, index: usize) -> <Scalar as Lanes>::F32 {
+        Scalar.splat_f32(Fragment::varying(self, index))
+    }
+    fn derivatives(&self, index: usize) -> (<Scalar as Lanes>::F32, <Scalar as Lanes>::F32) {
+        let (dx, dy) = Fragment::derivatives(self, index);
+        (Scalar.splat_f32(dx), Scalar.splat_f32(dy))
+    }
+    fn sample(&self, texture: &Texture, sampler: &Sampler) -> [<Scalar as Lanes>::F32; 4] {
+        let u = at::TEXCOORD;
+        let (du_dx, du_dy) = Fragment::derivatives(self, u);
+        let (dv_dx, dv_dy) = Fragment::derivatives(self, u + 1);
+        let t = texture.sample_grad(
+            sampler,
+            Vec2::new(Fragment::varying(self, u), Fragment::varying(self, u + 1)),
+            Vec2::new(du_dx, dv_dx),
+            Vec2::new(du_dy, dv_dy),
+        );
+        t.to_array().map(|c| Scalar.splat_f32(c))
+    }
+    fn front_facing(&self) -> bool {
+        self.front_facing
+    }
+    fn primitive_id(&self) -> u32 {
+        self.primitive_id
+    }
+}
+
+impl PbrShader<'_> {
+    /// The shading routine (see the module docs): colour and the lanes kept.
+    #[inline(always)]
+    fn shade<L: Lanes, F: Fragments<L>>(&self, f: &F) -> ([L::F32; 4], L::Mask) {
+        let lanes = f.lanes();
+        let all = lanes.mask_all(true);
+        let one = lanes.splat_f32(1.0);
+        let zero = lanes.splat_f32(0.0);
+        let m = self.material;
+        let needs_alpha = !matches!(m.alpha_mode, AlphaMode::Opaque);
+        if self.pass == Pass::Ids && !needs_alpha {
+            return (self.ids_lanes(lanes, f.primitive_id()), all);
+        }
+        // --- base colour and alpha ---
+        let factor = m.base_color_factor.to_array();
+        let mut base = factor.map(|c| lanes.splat_f32(c));
+        if self.vertex_colors {
+            for (c, b) in base.iter_mut().enumerate() {
+                *b = *b * f.varying(at::COLOR + c);
+            }
+        }
+        if let Some((texture, sampler)) = self.textures.base_color {
+            let texel = f.sample(texture, &sampler);
+            for c in 0..4 {
+                base[c] = base[c] * texel[c];
+            }
+        }
+        let (alpha, keep) = match m.alpha_mode {
+            AlphaMode::Opaque => (one, all),
+            AlphaMode::Mask { cutoff } => (one, base[3].simd_lt(lanes.splat_f32(cutoff)).not()),
+            AlphaMode::Blend => (base[3], all),
+        };
+        if self.pass == Pass::Ids {
+            return (self.ids_lanes(lanes, f.primitive_id()), keep);
+        }
+        let normal = self.normal(f);
+        if self.pass == Pass::Normals {
+            return ([normal[0], normal[1], normal[2], one], keep);
+        }
+        // --- emission ---
+        let e = m.emissive.to_array();
+        let mut emissive = e.map(|c| lanes.splat_f32(c));
+        if let Some((texture, sampler)) = self.textures.emissive {
+            let texel = f.sample(texture, &sampler);
+            for c in 0..3 {
+                emissive[c] = emissive[c] * texel[c];
+            }
+        }
+        let lit = if m.unlit {
+            [base[0], base[1], base[2]]
+        } else {
+            let mut metallic = lanes.splat_f32(m.metallic);
+            let mut roughness = lanes.splat_f32(m.roughness);
+            if let Some((texture, sampler)) = self.textures.metallic_roughness {
+                let texel = f.sample(texture, &sampler);
+                metallic = metallic * texel[2];
+                roughness = roughness * texel[1];
+            }
+            let clamp = |x: L::F32| x.max(zero).min(one);
+            let mut occlusion = one;
+            if let Some((texture, sampler)) = self.textures.occlusion {
+                let texel = f.sample(texture, &sampler);
+                occlusion = one + lanes.splat_f32(m.occlusion_strength) * (texel[0] - one);
+            }
+            let surface = Surface {
+                base: [base[0], base[1], base[2]],
+                metallic: clamp(metallic),
+                roughness: clamp(roughness),
+                occlusion,
+                normal,
+                position: [
+                    f.varying(at::POSITION),
+                    f.varying(at::POSITION + 1),
+                    f.varying(at::POSITION + 2),
+                ],
+            };
+            pbr::shade(lanes, self.lighting, &surface)
+        };
+        let rgb = [
+            lit[0] + emissive[0],
+            lit[1] + emissive[1],
+            lit[2] + emissive[2],
+        ];
+        let [r, g, b] = pbr::tonemap(lanes, self.lighting.tonemap, self.lighting.exposure, rgb);
+        ([r, g, b, alpha], keep)
+    }
+
+    /// The shading normal: the interpolated normal, bent by the normal texture (see the module
+    /// docs), flipped on back faces of double-sided materials.
+    #[inline(always)]
+    fn normal<L: Lanes, F: Fragments<L>>(&self, f: &F) -> [L::F32; 3] {
+        let lanes = f.lanes();
+        let ng = normalize3(
+            lanes,
+            [
+                f.varying(at::NORMAL),
+                f.varying(at::NORMAL + 1),
+                f.varying(at::NORMAL + 2),
+            ],
+        );
+        let mut n = ng;
+        if let Some((texture, sampler)) = self.textures.normal {
+            n = self.bent_normal(f, ng, texture, &sampler);
+        }
+        if self.material.double_sided && !f.front_facing() {
+            [-n[0], -n[1], -n[2]]
+        } else {
+            n
+        }
+    }
+
+    /// `ng` bent by the normal texture in the derivative tangent frame: `t_ = (∂v/∂y ∂p/∂x −
+    /// ∂v/∂x ∂p/∂y) / (∂u/∂x ∂v/∂y − ∂u/∂y ∂v/∂x)`, `t = normalize(t_ − ng (ng·t_))`,
+    /// `b = ng × t`, `n = normalize(t m.x + b m.y + ng m.z)` with `m = 2 texel − 1`, `m.xy ×=
+    /// scale`; `ng` where the frame is degenerate.
+    #[inline(always)]
+    fn bent_normal<L: Lanes, F: Fragments<L>>(
+        &self,
+        f: &F,
+        ng: [L::F32; 3],
+        texture: &Texture,
+        sampler: &Sampler,
+    ) -> [L::F32; 3] {
+        let lanes = f.lanes();
+        let one = lanes.splat_f32(1.0);
+        let (du_dx, du_dy) = f.derivatives(at::TEXCOORD);
+        let (dv_dx, dv_dy) = f.derivatives(at::TEXCOORD + 1);
+        let mut dp_dx = [lanes.splat_f32(0.0); 3];
+        let mut dp_dy = dp_dx;
+        for c in 0..3 {
+            (dp_dx[c], dp_dy[c]) = f.derivatives(at::POSITION + c);
+        }
+        let det = du_dx * dv_dy - du_dy * dv_dx;
+        let t_ = [
+            (dv_dy * dp_dx[0] - dv_dx * dp_dy[0]) / det,
+            (dv_dy * dp_dx[1] - dv_dx * dp_dy[1]) / det,
+            (dv_dy * dp_dx[2] - dv_dx * dp_dy[2]) / det,
+        ];
+        let along = ng[0] * t_[0] + ng[1] * t_[1] + ng[2] * t_[2];
+        let t = normalize3(
+            lanes,
+            [
+                t_[0] - ng[0] * along,
+                t_[1] - ng[1] * along,
+                t_[2] - ng[2] * along,
+            ],
+        );
+        let b = [
+            ng[1] * t[2] - ng[2] * t[1],
+            ng[2] * t[0] - ng[0] * t[2],
+            ng[0] * t[1] - ng[1] * t[0],
+        ];
+        let texel = f.sample(texture, sampler);
+        let two = lanes.splat_f32(2.0);
+        let scale = lanes.splat_f32(self.material.normal_scale);
+        let m = [
+            (texel[0] * two - one) * scale,
+            (texel[1] * two - one) * scale,
+            texel[2] * two - one,
+        ];
+        let bent = normalize3(
+            lanes,
+            [
+                t[0] * m[0] + b[0] * m[1] + ng[0] * m[2],
+                t[1] * m[0] + b[1] * m[1] + ng[1] * m[2],
+                t[2] * m[0] + b[2] * m[1] + ng[2] * m[2],
+            ],
+        );
+        // normalize3 gives 0 for a degenerate frame (t) or result: keep ng there.
+        let zero = lanes.splat_f32(0.0);
+        let usable = (t[0].simd_ne(zero).or(t[1].simd_ne(zero)).or(t[2].simd_ne(zero))).and(
+            bent[0]
+                .simd_ne(zero)
+                .or(bent[1].simd_ne(zero))
+                .or(bent[2].simd_ne(zero)),
+        );
+        [
+            usable.select_f32(bent[0], ng[0]),
+            usable.select_f32(bent[1], ng[1]),
+            usable.select_f32(bent[2], ng[2]),
+        ]
+    }
+
+    #[inline(always)]
+    fn ids_lanes<L: Lanes>(&self, lanes: L, primitive_id: u32) -> [L::F32; 4] {
+        [
+            lanes.splat_f32(self.ids.0),
+            lanes.splat_f32(primitive_id as f32 + 1.0),
+            lanes.splat_f32(self.ids.1),
+            lanes.splat_f32(1.0),
+        ]
+    }
+}
+
+impl Shader for PbrShader<'_> {
+    type Vertex = StandardVertex;
+
+    fn varying_count(&self) -> usize {
+        PbrShader::varying_count(self)
+    }
+
+    #[inline]
+    fn vertex(&self, vertex: &StandardVertex, varyings: &mut [f32]) -> Vec4 {
+        let count = PbrShader::varying_count(self);
+        varyings[..count].fill(0.0);
+        let n = self.normal_matrix * vertex.normal;
+        varyings[at::NORMAL..at::NORMAL + 3].copy_from_slice(&n.to_array());
+        let p = self.model.transform_point3(vertex.position);
+        varyings[at::POSITION..at::POSITION + 3].copy_from_slice(&p.to_array());
+        if count > at::TEXCOORD {
+            varyings[at::TEXCOORD..at::TEXCOORD + 2].copy_from_slice(&vertex.texcoord.to_array());
+        }
+        if self.vertex_colors {
+            varyings[at::COLOR..at::COLOR + 4].copy_from_slice(&vertex.color.to_array());
+        }
+        self.model_view_projection * vertex.position.extend(1.0)
+    }
+
+    fn fragment(&self, fragment: &Fragment<'_>) -> Option<Vec4> {
+        let (color, keep) = self.shade::<Scalar, _>(fragment);
+        keep.any().then(|| {
+            Vec4::new(
+                color[0].extract(0),
+                color[1].extract(0),
+                color[2].extract(0),
+                color[3].extract(0),
+            )
+        })
+    }
+
+    #[inline(always)]
+    fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+        let (color, keep) = self.shade(fragments);
+        ShadedLanes { color, keep }
+    }
+}
+
+#[cfg(test)]
+#[path = "pbr_material_tests.rs"]
+mod tests;
