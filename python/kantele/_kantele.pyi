@@ -15,9 +15,24 @@ MAX_SIZE: int
 OUTPUTS: List[str]
 """Every output name `render` knows."""
 
-def load(path: PathLike) -> Scene:
+Shading = Literal["auto", "lambert", "pbr"]
+Tonemap = Literal["none", "pbr-neutral", "aces"]
+
+def load(
+    path: PathLike,
+    shading: Shading = "auto",
+    environment: Optional[PathLike] = None,
+    environment_intensity: float = 1.0,
+    environment_rotation: float = 0.0,
+    exposure: float = 0.0,
+    tonemap: Tonemap = "pbr-neutral",
+) -> Scene:
     """Loads a glTF 2.0 (`.gltf`, `.glb`) or OBJ file. `FileNotFoundError`/`OSError` when it
-    cannot be read, `ValueError` when it is malformed."""
+    cannot be read, `ValueError` when it is malformed. `shading`: `auto` (glTF reference
+    scenes and OBJ files Lambert, other glTF files PBR), `lambert` or `pbr`; for PBR,
+    `environment` (`"studio"`, `"none"` or an .hdr / .exr file; default: the studio when the
+    file has no lights), `environment_intensity`, `environment_rotation` (degrees about +Y),
+    `exposure` (stops) and `tonemap`, as the `kantele` command's options."""
 
 def write_png(path: PathLike, image: npt.NDArray[np.uint8]) -> None:
     """Writes a `uint8` (H, W, 4) or (H, W, 3) image, row 0 at the top, as PNG."""
@@ -104,7 +119,15 @@ class Scene:
     """A scene ready to render."""
 
     @staticmethod
-    def load(path: PathLike) -> Scene:
+    def load(
+        path: PathLike,
+        shading: Shading = "auto",
+        environment: Optional[PathLike] = None,
+        environment_intensity: float = 1.0,
+        environment_rotation: float = 0.0,
+        exposure: float = 0.0,
+        tonemap: Tonemap = "pbr-neutral",
+    ) -> Scene:
         """Same as `kantele.load`."""
     @staticmethod
     def from_arrays(

@@ -20,10 +20,30 @@ use pyo3::prelude::*;
 use camera::PyCamera;
 use scene::PyScene;
 
-/// Loads a glTF 2.0 (`.gltf`, `.glb`) or OBJ file into a `Scene`.
+/// Loads a glTF 2.0 (`.gltf`, `.glb`) or OBJ file into a `Scene` (the arguments as
+/// `Scene.load`'s).
 #[pyfunction]
-fn load(py: Python<'_>, path: PathBuf) -> PyResult<PyScene> {
-    PyScene::load_path(py, path)
+#[pyo3(signature = (path, shading = "auto", environment = None, environment_intensity = 1.0, environment_rotation = 0.0, exposure = 0.0, tonemap = "pbr-neutral"))]
+#[allow(clippy::too_many_arguments)]
+fn load(
+    py: Python<'_>,
+    path: PathBuf,
+    shading: &str,
+    environment: Option<PathBuf>,
+    environment_intensity: f32,
+    environment_rotation: f32,
+    exposure: f32,
+    tonemap: &str,
+) -> PyResult<PyScene> {
+    let options = scene::shading_options(
+        shading,
+        environment,
+        environment_intensity,
+        environment_rotation,
+        exposure,
+        tonemap,
+    )?;
+    PyScene::load_path(py, path, options)
 }
 
 /// The instruction set the CPU renderer uses in this process (`avx512`, `avx2`, `sse41`,

@@ -8,7 +8,9 @@ use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::error::RenderError;
 use kantele::multisample::SampleCount;
 use kantele::rop::TargetFormat;
-use kantele::scene::Scene;
+use kantele::scene::{Scene, Shading};
+use kantele::shade::pbr::Tonemap;
+use kantele_scene::{EnvironmentChoice, LoadOptions};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -48,13 +50,66 @@ impl PyScene {
         })
     }
 
-    /// Loads a scene file (glTF or OBJ) with the GIL released.
-    pub fn load_path(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
+    /// Loads a scene file (glTF or OBJ) under `options` with the GIL released.
+    pub fn load_path(py: Python<'_>, path: PathBuf, options: LoadOptions) -> PyResult<Self> {
         let loaded = py
-            .detach(|| kantele_scene::load_scene(&path))
+            .detach(|| kantele_scene::load_scene_with(&path, &options))
             .map_err(load_error)?;
         Self::new(loaded.scene, loaded.info.source, loaded.info.warnings)
     }
+}
+
+/// The load options of `load`'s shading arguments (see `Scene.load`).
+pub fn shading_options(
+    shading: &str,
+    environment: Option<PathBuf>,
+    environment_intensity: f32,
+    environment_rotation: f32,
+    exposure: f32,
+    tonemap: &str,
+) -> PyResult<LoadOptions> {
+    let shading = match shading {
+        "auto" => None,
+        "lambert" => Some(Shading::Lambert),
+        "pbr" => Some(Shading::Pbr),
+        _ => {
+            return Err(value_error(format!(
+                "unknown shading '{shading}' (choose from: auto, lambert, pbr)"
+            )))
+        }
+    };
+    let environment = match environment {
+        None => EnvironmentChoice::Default,
+        Some(p) if p.as_os_str() == "studio" => EnvironmentChoice::Studio,
+        Some(p) if p.as_os_str() == "none" => EnvironmentChoice::None,
+        Some(p) => EnvironmentChoice::File(p),
+    };
+    let tonemap = Tonemap::from_name(tonemap).ok_or_else(|| {
+        value_error(format!(
+            "unknown tonemap '{tonemap}' (choose from: none, pbr-neutral, aces)"
+        ))
+    })?;
+    let finite = |name: &str, v: f32| {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(value_error(format!("{name} must be a finite number")))
+        }
+    };
+    if !(environment_intensity.is_finite() && environment_intensity >= 0.0) {
+        return Err(value_error(
+            "environment_intensity must be a finite number >= 0",
+        ));
+    }
+    Ok(LoadOptions {
+        shading,
+        environment,
+        environment_intensity,
+        environment_rotation_degrees: finite("environment_rotation", environment_rotation)?,
+        exposure: finite("exposure", exposure)?,
+        tonemap,
+        ..LoadOptions::default()
+    })
 }
 
 /// Which backend renders, parsed from the `backend` argument.
@@ -276,10 +331,34 @@ fn prefix(source: &str, error: RenderError) -> RenderError {
 #[pymethods]
 impl PyScene {
     /// Loads a glTF 2.0 (`.gltf`, `.glb`) or OBJ file. Raises `OSError` when the file cannot be
-    /// read and `ValueError` when it is malformed.
+    /// read and `ValueError` when it is malformed. `shading`: `auto` (glTF reference scenes
+    /// and OBJ files Lambert, other glTF files PBR), `lambert` or `pbr`; for PBR,
+    /// `environment` (`studio`, `none` or an .hdr / .exr file; default: the studio when the
+    /// file has no lights), `environment_intensity`, `environment_rotation` (degrees about
+    /// +Y), `exposure` (stops) and `tonemap` (`none`, `pbr-neutral`, `aces`), as the
+    /// `kantele` command's options of the same names.
     #[staticmethod]
-    fn load(py: Python<'_>, path: PathBuf) -> PyResult<Self> {
-        Self::load_path(py, path)
+    #[pyo3(signature = (path, shading = "auto", environment = None, environment_intensity = 1.0, environment_rotation = 0.0, exposure = 0.0, tonemap = "pbr-neutral"))]
+    #[allow(clippy::too_many_arguments)]
+    fn load(
+        py: Python<'_>,
+        path: PathBuf,
+        shading: &str,
+        environment: Option<PathBuf>,
+        environment_intensity: f32,
+        environment_rotation: f32,
+        exposure: f32,
+        tonemap: &str,
+    ) -> PyResult<Self> {
+        let options = shading_options(
+            shading,
+            environment,
+            environment_intensity,
+            environment_rotation,
+            exposure,
+            tonemap,
+        )?;
+        Self::load_path(py, path, options)
     }
 
     /// A scene of one mesh from numpy arrays: `vertices` (N, 3) floats, `faces` (M, 3)

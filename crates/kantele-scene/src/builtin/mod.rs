@@ -2,6 +2,7 @@
 
 mod cube;
 mod ground;
+mod pbr;
 mod pixel_edges;
 mod teapot;
 mod teapot_data;
@@ -29,6 +30,14 @@ pub const SCENES: &[(&str, &str)] = &[
         "pixel-edges",
         "quads whose edges run exactly through pixel centres: only the fill rule decides their edge pixels",
     ),
+    (
+        "pbr-spheres",
+        "PBR: 5x5 spheres over metallic (up) and roughness (right) in the built-in studio with a key light",
+    ),
+    (
+        "pbr-lights",
+        "PBR: a normal-mapped floor, a gold and a plastic sphere under a point and a spot light with ranges",
+    ),
 ];
 
 /// Background of the built-in scenes: a dark grey-blue (linear).
@@ -41,6 +50,8 @@ pub fn build(name: &str) -> Option<LoadedScene> {
         "teapot" => teapot::scene(),
         "ground" => ground::scene(),
         "pixel-edges" => pixel_edges::scene(),
+        "pbr-spheres" => pbr::spheres(),
+        "pbr-lights" => pbr::lights(),
         _ => return None,
     };
     Some(finish(name, scene, info))

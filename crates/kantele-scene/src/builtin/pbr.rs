@@ -1,0 +1,269 @@
+//! Built-in PBR scenes, the reference scenes of the metallic-roughness model: a grid of spheres
+//! over metallic × roughness in the studio environment, and a normal-mapped floor under point
+//! and spot lights with ranges.
+
+use std::f32::consts::PI;
+use std::sync::Arc;
+
+use glam::{Mat4, Vec2, Vec3, Vec4};
+use kantele_rules::camera;
+use kantele_rules::scene::{
+    Camera, Draw, LightKind, Material, Mesh, PunctualLight, Scene, Shading, TextureBinding,
+};
+use kantele_rules::shade::environment::EnvironmentLight;
+use kantele_rules::shade::texture::{ColorSpace, Texture};
+
+use crate::texture_util::trilinear_repeat;
+use crate::SceneInfo;
+
+/// A UV sphere of radius 1: `rings` bands from pole to pole, `segments` around, `u` around
+/// (+X towards −Z), `v` from the north pole down.
+fn sphere(rings: u32, segments: u32, material: usize) -> Mesh {
+    let mut positions = Vec::new();
+    let mut texcoords = Vec::new();
+    for r in 0..=rings {
+        let v = r as f32 / rings as f32;
+        let theta = v * PI;
+        for s in 0..=segments {
+            let u = s as f32 / segments as f32;
+            let phi = u * 2.0 * PI;
+            positions.push(Vec3::new(
+                theta.sin() * phi.cos(),
+                theta.cos(),
+                -theta.sin() * phi.sin(),
+            ));
+            texcoords.push(Vec2::new(u, v));
+        }
+    }
+    let mut indices = Vec::new();
+    let row = segments + 1;
+    for r in 0..rings {
+        for s in 0..segments {
+            let (a, b) = (r * row + s, (r + 1) * row + s);
+            indices.extend_from_slice(&[a, b, a + 1, a + 1, b, b + 1]);
+        }
+    }
+    Mesh {
+        name: "sphere".into(),
+        normals: Some(positions.clone()),
+        positions,
+        texcoords: Some(texcoords),
+        indices,
+        material,
+        ..Mesh::default()
+    }
+}
+
+/// A square of side 2 in the XZ plane facing +Y, its texture repeated `repeat` times.
+fn floor(material: usize, repeat: f32) -> Mesh {
+    Mesh {
+        name: "floor".into(),
+        positions: vec![
+            Vec3::new(-1.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, 1.0),
+            Vec3::new(1.0, 0.0, -1.0),
+            Vec3::new(-1.0, 0.0, -1.0),
+        ],
+        normals: Some(vec![Vec3::Y; 4]),
+        texcoords: Some(vec![
+            Vec2::new(0.0, repeat),
+            Vec2::new(repeat, repeat),
+            Vec2::new(repeat, 0.0),
+            Vec2::new(0.0, 0.0),
+        ]),
+        indices: vec![0, 1, 2, 0, 2, 3],
+        material,
+        ..Mesh::default()
+    }
+}
+
+fn draw(mesh: usize, model: Mat4, name: String, node_index: usize) -> Draw {
+    Draw {
+        mesh,
+        model,
+        node_name: name,
+        node_index,
+    }
+}
+
+fn perspective(eye: Vec3, target: Vec3, yfov_deg: f32) -> Camera {
+    Camera {
+        view: camera::look_at(eye, target, Vec3::Y),
+        yfov: yfov_deg.to_radians(),
+        ymag: None,
+        aspect_ratio: None,
+        znear: 0.1,
+        zfar: Some(100.0),
+    }
+}
+
+/// `pbr-spheres`: 5 × 5 spheres, metallic 0 → 1 upwards, roughness 0 → 1 rightwards, a warm
+/// base colour, in the built-in studio with one directional key light.
+pub fn spheres() -> (Scene, SceneInfo) {
+    let mut materials = Vec::new();
+    let mut meshes = Vec::new();
+    let mut draws = Vec::new();
+    for row in 0..5 {
+        for column in 0..5 {
+            let metallic = row as f32 / 4.0;
+            let roughness = column as f32 / 4.0;
+            materials.push(Material {
+                name: format!("metallic {metallic} roughness {roughness}"),
+                base_color_factor: Vec4::new(0.95, 0.64, 0.38, 1.0),
+                metallic,
+                roughness,
+                ..Material::default()
+            });
+            let index = materials.len() - 1;
+            meshes.push(sphere(32, 48, index));
+            let at = Vec3::new(
+                (column as f32 - 2.0) * 2.3,
+                (row as f32 - 2.0) * 2.3,
+                0.0,
+            );
+            draws.push(draw(
+                index,
+                Mat4::from_translation(at),
+                format!("sphere m{row} r{column}"),
+                index,
+            ));
+        }
+    }
+    let scene = Scene {
+        meshes,
+        materials,
+        draws,
+        camera: perspective(Vec3::new(0.0, 0.0, 21.0), Vec3::ZERO, 35.0),
+        shading: Shading::Pbr,
+        lights: vec![PunctualLight {
+            kind: LightKind::Directional,
+            color: Vec3::splat(2.0),
+            position: Vec3::ZERO,
+            direction: Vec3::new(0.5, -0.6, -0.6).normalize(),
+            range: None,
+        }],
+        environment: Some(EnvironmentLight::studio()),
+        clear_color: crate::shading::PBR_BACKGROUND,
+        resolution: (800, 800),
+        ..Scene::default()
+    };
+    let info = SceneInfo {
+        camera_from_file: true,
+        lights: scene.lights.iter().map(|_| "light".to_string()).collect(),
+        ..SceneInfo::default()
+    };
+    (scene, info)
+}
+
+/// A `size²` linear normal map of round bumps (`cells` per side), tangent space.
+fn bump_map(size: u32, cells: u32) -> Texture {
+    let rgba: Vec<u8> = (0..size * size)
+        .flat_map(|i| {
+            let (x, y) = (i % size, i / size);
+            let cell = size as f32 / cells as f32;
+            let p = Vec2::new(
+                (x as f32 + 0.5) % cell / cell - 0.5,
+                (y as f32 + 0.5) % cell / cell - 0.5,
+            );
+            // A spherical cap of radius 0.4: its slope tilts the normal outwards.
+            let r2 = p.length_squared();
+            let n = if r2 < 0.16 {
+                let h = (0.16 - r2).sqrt();
+                // ∂h/∂u = −u / h; v runs down the image, so +y of tangent space is −v.
+                Vec3::new(p.x / h, -p.y / h, 1.0).normalize()
+            } else {
+                Vec3::Z
+            };
+            let encode = |c: f32| ((c * 0.5 + 0.5) * 255.0).round() as u8;
+            [encode(n.x), encode(n.y), encode(n.z), 255]
+        })
+        .collect();
+    Texture::from_rgba8(size, size, &rgba, ColorSpace::Linear)
+        .expect("a generated bump map is a valid texture")
+}
+
+/// `pbr-lights`: a normal-mapped floor, a metal and a plastic sphere, lit by a point light and
+/// a spot light with ranges only (no environment).
+pub fn lights() -> (Scene, SceneInfo) {
+    let materials = vec![
+        Material {
+            name: "bumpy floor".into(),
+            base_color_factor: Vec4::new(0.8, 0.8, 0.78, 1.0),
+            metallic: 0.0,
+            roughness: 0.45,
+            normal_texture: Some(TextureBinding {
+                texture: 0,
+                sampler: trilinear_repeat(),
+            }),
+            normal_scale: 1.0,
+            ..Material::default()
+        },
+        Material {
+            name: "gold".into(),
+            base_color_factor: Vec4::new(1.0, 0.77, 0.34, 1.0),
+            metallic: 1.0,
+            roughness: 0.25,
+            ..Material::default()
+        },
+        Material {
+            name: "blue plastic".into(),
+            base_color_factor: Vec4::new(0.05, 0.2, 0.7, 1.0),
+            metallic: 0.0,
+            roughness: 0.35,
+            ..Material::default()
+        },
+    ];
+    let meshes = vec![floor(0, 8.0), sphere(32, 48, 1), sphere(32, 48, 2)];
+    let draws = vec![
+        draw(0, Mat4::from_scale(Vec3::splat(6.0)), "floor".into(), 0),
+        draw(
+            1,
+            Mat4::from_translation(Vec3::new(-1.4, 1.0, 0.0)),
+            "gold sphere".into(),
+            1,
+        ),
+        draw(
+            2,
+            Mat4::from_translation(Vec3::new(1.4, 1.0, 0.5)),
+            "plastic sphere".into(),
+            2,
+        ),
+    ];
+    let scene = Scene {
+        meshes,
+        materials,
+        textures: vec![Arc::new(bump_map(256, 8))],
+        draws,
+        camera: perspective(Vec3::new(0.0, 4.0, 8.0), Vec3::new(0.0, 0.6, 0.0), 40.0),
+        shading: Shading::Pbr,
+        lights: vec![
+            PunctualLight {
+                kind: LightKind::Point,
+                color: Vec3::new(1.0, 0.85, 0.7) * 25.0,
+                position: Vec3::new(-2.5, 3.0, 2.0),
+                direction: Vec3::NEG_Z,
+                range: Some(9.0),
+            },
+            PunctualLight {
+                kind: LightKind::Spot {
+                    inner_cone_angle: 0.25,
+                    outer_cone_angle: 0.45,
+                },
+                color: Vec3::new(0.7, 0.8, 1.0) * 60.0,
+                position: Vec3::new(2.5, 5.0, 1.0),
+                direction: (Vec3::new(1.0, 0.0, 0.3) - Vec3::new(2.5, 5.0, 1.0)).normalize(),
+                range: Some(12.0),
+            },
+        ],
+        environment: None,
+        clear_color: Vec4::new(0.02, 0.02, 0.025, 1.0),
+        resolution: (960, 640),
+        ..Scene::default()
+    };
+    let info = SceneInfo {
+        camera_from_file: true,
+        lights: scene.lights.iter().map(|_| "light".to_string()).collect(),
+        ..SceneInfo::default()
+    };
+    (scene, info)
+}
