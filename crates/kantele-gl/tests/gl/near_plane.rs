@@ -72,6 +72,7 @@ fn ground(extent: f32, eye: Vec3, target: Vec3, znear: f32, zfar: Option<f32>) -
         ambient: 0.0,
         clear_color: Vec4::new(0.0, 0.0, 0.0, 1.0),
         resolution: (320, 240),
+        ..Scene::default()
     }
 }
 

@@ -113,6 +113,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         ambient: 0.1,
         clear_color: CLEAR_COLOR,
         resolution: (1300, 700),
+        ..Scene::default()
     };
     let info = SceneInfo {
         cameras: vec!["camera".into()],

@@ -133,6 +133,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         ambient: 0.15,
         clear_color: CLEAR_COLOR,
         resolution: (1024, 768),
+        ..Scene::default()
     };
     let info = SceneInfo {
         cameras: vec!["camera".into()],

@@ -86,6 +86,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         ambient: 0.1,
         clear_color: CLEAR_COLOR,
         resolution: (WIDTH, HEIGHT),
+        ..Scene::default()
     };
     let info = SceneInfo {
         cameras: vec!["pixel-centre camera".into()],

@@ -123,6 +123,7 @@ impl Loader<'_> {
             unlit: material.unlit(),
             emissive,
             emissive_texture,
+            ..Material::default()
         })
     }
 
