@@ -172,7 +172,10 @@ impl<L: Lanes> Fragments<L> for FragmentLanes<'_, L> {
         let (dv_dx, dv_dy) = FragmentLanes::derivatives(self, u + 1);
         texture.sample_grad_lanes::<L>(
             sampler,
-            [FragmentLanes::varying(self, u), FragmentLanes::varying(self, u + 1)],
+            [
+                FragmentLanes::varying(self, u),
+                FragmentLanes::varying(self, u + 1),
+            ],
             [du_dx, dv_dx],
             [du_dy, dv_dy],
             self.active,
@@ -389,7 +392,11 @@ impl PbrShader<'_> {
         );
         // normalize3 gives 0 for a degenerate frame (t) or result: keep ng there.
         let zero = lanes.splat_f32(0.0);
-        let usable = (t[0].simd_ne(zero).or(t[1].simd_ne(zero)).or(t[2].simd_ne(zero))).and(
+        let usable = (t[0]
+            .simd_ne(zero)
+            .or(t[1].simd_ne(zero))
+            .or(t[2].simd_ne(zero)))
+        .and(
             bent[0]
                 .simd_ne(zero)
                 .or(bent[1].simd_ne(zero))

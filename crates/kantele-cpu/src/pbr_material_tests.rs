@@ -266,9 +266,16 @@ fn the_normals_pass_writes_the_shading_normal() {
     };
     let front = render(&shader(Mat4::IDENTITY), &quad(), RendererOptions::default());
     let n = front.iter().find(|c| c[3] > 0.0).expect("covered");
-    let want = Vec3::new(191.0 / 255.0 * 2.0 - 1.0, 128.0 / 255.0 * 2.0 - 1.0, 221.0 / 255.0 * 2.0 - 1.0)
-        .normalize();
-    assert!((Vec3::new(n[0], n[1], n[2]) - want).length() < 1e-3, "{n:?} vs {want}");
+    let want = Vec3::new(
+        191.0 / 255.0 * 2.0 - 1.0,
+        128.0 / 255.0 * 2.0 - 1.0,
+        221.0 / 255.0 * 2.0 - 1.0,
+    )
+    .normalize();
+    assert!(
+        (Vec3::new(n[0], n[1], n[2]) - want).length() < 1e-3,
+        "{n:?} vs {want}"
+    );
     // Turned around: the back face shows; its normal faces the camera again.
     let back = render(
         &shader(Mat4::from_rotation_y(std::f32::consts::PI)),

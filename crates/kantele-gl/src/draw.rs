@@ -1,14 +1,17 @@
-//! One frame's GL commands: the fixed state, then per draw its culling, alpha mode, blending,
-//! uniforms, textures and primitive mode, in the scene's draw order.
+//! One frame's GL commands: the fixed state, the program of the scene's shading (Lambert or
+//! PBR) and its frame uniforms, then per draw its culling, alpha mode, blending, uniforms,
+//! textures and primitive mode, in the scene's draw order.
 
 use glam::{Mat3, Mat4, Vec4};
 use glow::HasContext;
 use kantele_rules::backend::{FrameView, Pass};
 use kantele_rules::camera::normal_matrix;
-use kantele_rules::scene::{AlphaMode, Scene, Topology};
+use kantele_rules::scene::{AlphaMode, Material, Scene, Shading, Topology};
+use kantele_rules::shade::pbr::PbrLighting;
 use kantele_rules::stats::FrameStats;
 use kantele_rules::RenderError;
 
+use crate::pbr;
 use crate::{shaders, GlBackend};
 
 impl GlBackend {
@@ -24,7 +27,13 @@ impl GlBackend {
         stats: &mut FrameStats,
     ) -> Result<(), RenderError> {
         let gl = &self.gl;
-        let u = &self.uniforms;
+        // Lambert scenes: the Lambert program, its uniforms and GL calls exactly as ever.
+        let pbr = scene.shading == Shading::Pbr;
+        let (program, u) = if pbr {
+            (self.pbr_program, &self.pbr_uniforms.common)
+        } else {
+            (self.program, &self.uniforms)
+        };
         let color_pass = view.pass == Pass::Color;
         let pass = match view.pass {
             Pass::Color => shaders::PASS_COLOR,
@@ -73,7 +82,16 @@ impl GlBackend {
             );
             gl.blend_equation(glow::FUNC_ADD);
 
-            gl.use_program(Some(self.program));
+            gl.use_program(Some(program));
+            if pbr {
+                let lighting = PbrLighting::for_frame(scene, view);
+                pbr::set_frame_uniforms(
+                    gl,
+                    &self.pbr_uniforms,
+                    &lighting,
+                    self.gpu.environment.as_ref(),
+                );
+            }
             gl.uniform_3_f32_slice(u.to_light.as_ref(), &view.to_light.to_array());
             gl.uniform_3_f32_slice(u.light_color.as_ref(), &view.light_color.to_array());
             gl.uniform_1_f32(u.ambient.as_ref(), scene.ambient);
@@ -159,6 +177,9 @@ impl GlBackend {
                         gl.bind_sampler(1, None);
                     }
                 }
+                if pbr {
+                    self.set_pbr_draw_uniforms(draw, material, mesh.material);
+                }
                 gl.active_texture(glow::TEXTURE0);
                 match material.base_color_texture {
                     Some(binding) => {
@@ -186,5 +207,59 @@ impl GlBackend {
             gl.finish();
         }
         self.check("rendering the frame")
+    }
+}
+
+impl GlBackend {
+    /// The PBR program's uniforms and textures of one draw: the model matrix, the material's
+    /// metallic, roughness, normal scale and occlusion strength, and its metallic-roughness,
+    /// normal and occlusion textures on their units with the samplers of material
+    /// `material_index`.
+    ///
+    /// # Safety
+    /// `self.gl` must be current on this thread with the PBR program in use; `material` must be
+    /// material `material_index` of the loaded scene (or its unlit copy), whose texture indices
+    /// were validated.
+    unsafe fn set_pbr_draw_uniforms(
+        &self,
+        draw: &kantele_rules::scene::Draw,
+        material: &Material,
+        material_index: usize,
+    ) {
+        let gl = &self.gl;
+        let u = &self.pbr_uniforms;
+        let [metallic_roughness, normal, occlusion] = material.pbr_textures();
+        let samplers = self.gpu.pbr_samplers[material_index];
+        // SAFETY: caller's contract; the textures and samplers are ours and alive.
+        unsafe {
+            gl.uniform_matrix_4_f32_slice(u.model.as_ref(), false, &draw.model.to_cols_array());
+            gl.uniform_1_f32(u.metallic.as_ref(), material.metallic);
+            gl.uniform_1_f32(u.roughness.as_ref(), material.roughness);
+            gl.uniform_1_f32(u.normal_scale.as_ref(), material.normal_scale);
+            gl.uniform_1_f32(u.occlusion_strength.as_ref(), material.occlusion_strength);
+            for (binding, sampler, unit, has) in [
+                (
+                    metallic_roughness,
+                    samplers[0],
+                    pbr::UNIT_METALLIC_ROUGHNESS,
+                    &u.has_metallic_roughness_texture,
+                ),
+                (normal, samplers[1], pbr::UNIT_NORMAL, &u.has_normal_texture),
+                (
+                    occlusion,
+                    samplers[2],
+                    pbr::UNIT_OCCLUSION,
+                    &u.has_occlusion_texture,
+                ),
+            ] {
+                gl.active_texture(glow::TEXTURE0 + unit);
+                gl.uniform_1_i32(has.as_ref(), binding.is_some() as i32);
+                gl.bind_texture(
+                    glow::TEXTURE_2D,
+                    binding.map(|b| self.gpu.textures[b.texture]),
+                );
+                gl.bind_sampler(unit, binding.and(sampler));
+            }
+        }
     }
 }

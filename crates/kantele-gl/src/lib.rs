@@ -48,13 +48,25 @@
 //!   its 8-bit texels, `GL_SRGB8_ALPHA8` for sRGB textures and `GL_RGBA8` otherwise, so both
 //!   renderers decode and filter identical texels. Rows go up in memory
 //!   order: the image's top row is GL's `t = 0` row, which is where glTF's `v = 0` points. One
-//!   sampler object per textured material carries the glTF wrap modes and filters.
+//!   sampler object per texture binding of a material carries the glTF wrap modes and filters.
+//!   The metallic-roughness, normal and occlusion textures are linear, hence `GL_RGBA8`.
 //! - **Meshes without normals** are split into one vertex triple per triangle carrying the
 //!   object-space face normal (flat shading).
 //! - **Alpha.** OPAQUE writes alpha 1; MASK discards fragments with alpha below the cutoff and
 //!   writes alpha 1; BLEND uses `glBlendFuncSeparate(SRC_ALPHA, ONE_MINUS_SRC_ALPHA, ONE,
 //!   ONE_MINUS_SRC_ALPHA)` with depth writes off, so the stored alpha is
 //!   `src.a + dst.a × (1 − src.a)` (the "over" operator's coverage).
+//! - **PBR.** Scenes whose [`Scene::shading`] is [`Shading::Pbr`] are drawn with a second
+//!   program (the Lambert one is untouched) that follows `kantele_rules::shade::pbr`
+//!   operation for operation: metallic-roughness (blue, green), occlusion (red) and normal
+//!   textures, up to [`MAX_LIGHTS`] punctual lights as uniform arrays, the environment, exposure
+//!   and the tone map, all from [`PbrLighting::for_frame`]. The tangent of normal mapping comes
+//!   from `dFdx`/`dFdy` of the world position and texture coordinate (the y-flip makes `dFdy`
+//!   the derivative towards increasing image row, as the CPU's). The environment is uploaded
+//!   at `load`: the SH coefficients are uniforms, the six pre-filtered octahedral levels share
+//!   one `GL_RGB32F` atlas and the split-sum table is a `GL_RG32F` texture, all read with
+//!   `texelFetch` and the rules' own bilinear arithmetic, never GL's filtering. The normal pass
+//!   writes the normal-mapped normal.
 //! - **Passes.** [`Pass::Normals`] writes the world normal after two-sided flipping, alpha 1;
 //!   [`Pass::Ids`] writes `(node_index + 1, gl_PrimitiveID + 1, draw index + 1, 1)`. Both clear to
 //!   0 and never blend; MASK discards as in the colour pass and BLEND geometry is drawn without
@@ -77,6 +89,7 @@
 
 mod draw;
 mod egl;
+mod pbr;
 mod program;
 mod resources;
 mod shaders;
@@ -94,9 +107,14 @@ use kantele_rules::stats::FrameStats;
 use kantele_rules::RenderError;
 
 #[cfg(doc)]
+use kantele_rules::scene::Shading;
+#[cfg(doc)]
+use kantele_rules::shade::pbr::{PbrLighting, MAX_LIGHTS};
+#[cfg(doc)]
 use kantele_rules::shade::texture::Texture;
 
 use crate::egl::EglContext;
+use crate::pbr::{pbr_uniforms, PbrUniforms};
 use crate::program::{build_program, uniforms, Uniforms};
 use crate::resources::GpuScene;
 use crate::target::Target;
@@ -124,8 +142,12 @@ fn unsupported(message: impl Into<String>) -> RenderError {
 pub struct GlBackend {
     // `Drop` deletes the GL objects; then the fields drop in order, `egl` (the context) last.
     gl: glow::Context,
+    /// The Lambert program (`Shading::Lambert` scenes).
     program: glow::Program,
     uniforms: Uniforms,
+    /// The PBR program (`Shading::Pbr` scenes).
+    pbr_program: glow::Program,
+    pbr_uniforms: PbrUniforms,
     scene: Option<Arc<Scene>>,
     gpu: GpuScene,
     target: Option<Target>,
@@ -147,7 +169,8 @@ pub struct GlBackend {
 }
 
 impl GlBackend {
-    /// Creates a headless desktop OpenGL 3.3+ core context and the shader program.
+    /// Creates a headless desktop OpenGL 3.3+ core context and the shader programs (Lambert and
+    /// PBR).
     ///
     /// `libEGL.so.1` is loaded at run time. Displays are tried in this order: an
     /// `EGL_EXT_platform_device` hardware device (NVIDIA's EGL has no surfaceless platform),
@@ -182,15 +205,22 @@ impl GlBackend {
             )));
         }
         // SAFETY: `gl` is current on this thread.
-        let program = unsafe { build_program(&gl) }.map_err(backend_error)?;
-        // SAFETY: `gl` is current; `program` is ours and linked.
-        let uniforms = unsafe { uniforms(&gl, program) };
+        let program = unsafe { build_program(&gl, shaders::VERTEX, shaders::FRAGMENT) }
+            .map_err(backend_error)?;
+        // SAFETY: `gl` is current on this thread.
+        let pbr_program = unsafe { build_program(&gl, pbr::VERTEX, &pbr::fragment_source()) }
+            .map_err(|e| backend_error(format!("PBR program: {e}")))?;
+        // SAFETY: `gl` is current; the programs are ours and linked.
+        let (uniforms, pbr_uniforms) =
+            unsafe { (uniforms(&gl, program), pbr_uniforms(&gl, pbr_program)) };
         // SAFETY: `gl` is current on this thread.
         let max_samples = unsafe { gl.get_parameter_i32(glow::MAX_SAMPLES) };
         let backend = Self {
             gl,
             program,
             uniforms,
+            pbr_program,
+            pbr_uniforms,
             scene: None,
             gpu: GpuScene::default(),
             target: None,
@@ -462,6 +492,7 @@ impl Drop for GlBackend {
                 self.delete_target();
                 self.gl.use_program(None);
                 self.gl.delete_program(self.program);
+                self.gl.delete_program(self.pbr_program);
             }
         }
     }

@@ -1,11 +1,10 @@
-//! The shader program: compiling and linking the GLSL of [`crate::shaders`], and its uniform
-//! locations.
+//! The shader programs: compiling and linking GLSL (the Lambert program of [`crate::shaders`],
+//! the PBR program of [`crate::pbr`]), and the Lambert program's uniform locations.
 
 use glow::HasContext;
 
-use crate::shaders;
-
-/// Uniform locations of the shader program.
+/// Uniform locations of the Lambert program (also looked up in the PBR program, which lacks
+/// the light and ambient ones).
 pub(crate) struct Uniforms {
     pub(crate) model_view_projection: Option<glow::UniformLocation>,
     pub(crate) normal_matrix: Option<glow::UniformLocation>,
@@ -26,19 +25,23 @@ pub(crate) struct Uniforms {
     pub(crate) ids: Option<glow::UniformLocation>,
 }
 
-/// Compiles and links the shader program.
+/// Compiles and links a program of a vertex and a fragment shader.
 ///
 /// # Safety
 /// `gl` must be current on this thread.
-pub(crate) unsafe fn build_program(gl: &glow::Context) -> Result<glow::Program, String> {
+pub(crate) unsafe fn build_program(
+    gl: &glow::Context,
+    vertex: &str,
+    fragment: &str,
+) -> Result<glow::Program, String> {
     // SAFETY: the context is current (caller's contract); shaders and program are created here
     // and the shaders are deleted once linked (or on failure).
     unsafe {
         let program = gl.create_program()?;
         let mut shaders = Vec::new();
         for (kind, source, what) in [
-            (glow::VERTEX_SHADER, shaders::VERTEX, "vertex"),
-            (glow::FRAGMENT_SHADER, shaders::FRAGMENT, "fragment"),
+            (glow::VERTEX_SHADER, vertex, "vertex"),
+            (glow::FRAGMENT_SHADER, fragment, "fragment"),
         ] {
             let shader = gl.create_shader(kind)?;
             gl.shader_source(shader, source);

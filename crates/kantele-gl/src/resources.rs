@@ -1,8 +1,13 @@
 //! Scene data in GL objects: one vertex array + vertex buffer + index buffer per mesh, one RGBA8 /
-//! SRGB8_ALPHA8 texture with its complete mip chain per texture, one sampler object per textured material.
+//! SRGB8_ALPHA8 texture with its complete mip chain per texture, one sampler object per texture
+//! binding of a material, and for a PBR scene with an environment its pre-filtered levels and
+//! split-sum table as float textures.
 
 use glow::HasContext;
-use kantele_rules::scene::{Material, Mesh, Scene};
+use kantele_rules::scene::{Material, Mesh, Scene, Shading};
+use kantele_rules::shade::environment::{
+    brdf_table, Environment, BRDF_TABLE_SIZE, SPECULAR_LEVELS,
+};
 use kantele_rules::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
 use kantele_rules::vertex::StandardVertex;
 
@@ -27,6 +32,24 @@ pub(crate) struct GpuScene {
     pub(crate) samplers: Vec<Option<glow::Sampler>>,
     /// Per material: the sampler object of its emissive texture, if it has one.
     pub(crate) emissive_samplers: Vec<Option<glow::Sampler>>,
+    /// Per material: the sampler objects of its metallic-roughness, normal and occlusion
+    /// textures ([`Material::pbr_textures`]), where it has them.
+    pub(crate) pbr_samplers: Vec<[Option<glow::Sampler>; 3]>,
+    /// The environment of a PBR scene, if it has one.
+    pub(crate) environment: Option<GpuEnvironment>,
+}
+
+/// An environment on the GPU, read by the PBR program with `texelFetch` only: the
+/// pre-filtered levels of [`Environment::levels`] stacked in one `GL_RGB32F` atlas (level 0 at
+/// row 0, each level `(size + 2)²` texels with its border, at column 0), and the split-sum table
+/// of [`brdf_table`] as a `BRDF_TABLE_SIZE²` `GL_RG32F` texture (x: `NdotV`, y: roughness).
+pub(crate) struct GpuEnvironment {
+    pub(crate) atlas: glow::Texture,
+    pub(crate) brdf: glow::Texture,
+    /// The atlas row where each level starts.
+    pub(crate) rows: [i32; SPECULAR_LEVELS],
+    /// Each level's size without its border.
+    pub(crate) sizes: [i32; SPECULAR_LEVELS],
 }
 
 /// Interleaved vertices (position, normal, texcoord, colour: [`VERTEX_FLOATS`] floats) and u32
@@ -147,6 +170,139 @@ pub(crate) unsafe fn upload_texture(
     }
 }
 
+/// The level atlas of an environment: `(width, height, RGB f32 texels row by row, first row of
+/// each level, size of each level)`; an error when the levels are not the rules' six bordered
+/// squares.
+#[allow(clippy::type_complexity)]
+pub(crate) fn environment_atlas(
+    environment: &Environment,
+) -> Result<
+    (
+        usize,
+        usize,
+        Vec<f32>,
+        [i32; SPECULAR_LEVELS],
+        [i32; SPECULAR_LEVELS],
+    ),
+    String,
+> {
+    let levels = &environment.levels;
+    if levels.len() != SPECULAR_LEVELS {
+        return Err(format!(
+            "{} pre-filtered levels, expected {SPECULAR_LEVELS}",
+            levels.len()
+        ));
+    }
+    let mut rows = [0i32; SPECULAR_LEVELS];
+    let mut sizes = [0i32; SPECULAR_LEVELS];
+    let (mut width, mut height) = (0usize, 0usize);
+    for (k, level) in levels.iter().enumerate() {
+        let stride = level.stride() as usize;
+        if level.size == 0 || level.size > 1 << 14 || level.texels.len() != stride * stride {
+            return Err(format!(
+                "level {k}: {} texels for size {}",
+                level.texels.len(),
+                level.size
+            ));
+        }
+        rows[k] = height as i32;
+        sizes[k] = level.size as i32;
+        width = width.max(stride);
+        height += stride;
+    }
+    let mut texels = vec![0.0f32; width * height * 3];
+    for (k, level) in levels.iter().enumerate() {
+        let stride = level.stride() as usize;
+        for (y, row) in level.texels.chunks_exact(stride).enumerate() {
+            let start = (rows[k] as usize + y) * width * 3;
+            for (x, texel) in row.iter().enumerate() {
+                texels[start + 3 * x..start + 3 * x + 3].copy_from_slice(texel);
+            }
+        }
+    }
+    Ok((width, height, texels, rows, sizes))
+}
+
+/// A float texture of one level read by `texelFetch` (nearest filters, no mip levels).
+///
+/// # Safety
+/// `gl` must be current on this thread; `texels` holds `width × height` texels of `format`.
+unsafe fn upload_float_texture(
+    gl: &glow::Context,
+    internal_format: u32,
+    format: u32,
+    (width, height): (usize, usize),
+    texels: &[f32],
+) -> Result<glow::Texture, String> {
+    // SAFETY: the context is current (caller's contract); the texture is created here; rows of
+    // f32 texels are 4-byte aligned, so UNPACK_ALIGNMENT 4 adds no padding.
+    unsafe {
+        let max_size = gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE);
+        if width as i64 > max_size as i64 || height as i64 > max_size as i64 {
+            return Err(format!(
+                "{width}x{height} exceeds GL_MAX_TEXTURE_SIZE {max_size}"
+            ));
+        }
+        let handle = gl.create_texture()?;
+        gl.bind_texture(glow::TEXTURE_2D, Some(handle));
+        gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
+        gl.pixel_store_i32(glow::UNPACK_ROW_LENGTH, 0);
+        gl.tex_image_2d(
+            glow::TEXTURE_2D,
+            0,
+            internal_format as i32,
+            width as i32,
+            height as i32,
+            0,
+            format,
+            glow::FLOAT,
+            glow::PixelUnpackData::Slice(Some(&f32_bytes(texels.iter().copied()))),
+        );
+        for (parameter, value) in [
+            (glow::TEXTURE_MIN_FILTER, glow::NEAREST),
+            (glow::TEXTURE_MAG_FILTER, glow::NEAREST),
+            (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE),
+            (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE),
+        ] {
+            gl.tex_parameter_i32(glow::TEXTURE_2D, parameter, value as i32);
+        }
+        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_BASE_LEVEL, 0);
+        gl.tex_parameter_i32(glow::TEXTURE_2D, glow::TEXTURE_MAX_LEVEL, 0);
+        gl.bind_texture(glow::TEXTURE_2D, None);
+        Ok(handle)
+    }
+}
+
+/// Uploads an environment's levels and the split-sum table.
+///
+/// # Safety
+/// `gl` must be current on this thread.
+pub(crate) unsafe fn upload_environment(
+    gl: &glow::Context,
+    environment: &Environment,
+) -> Result<GpuEnvironment, String> {
+    let (width, height, texels, rows, sizes) = environment_atlas(environment)?;
+    let table: Vec<f32> = brdf_table().iter().flatten().copied().collect();
+    // SAFETY: forwarded caller's contract; the slices hold the declared texel counts.
+    unsafe {
+        let atlas = upload_float_texture(gl, glow::RGB32F, glow::RGB, (width, height), &texels)?;
+        let size = (BRDF_TABLE_SIZE, BRDF_TABLE_SIZE);
+        let brdf = match upload_float_texture(gl, glow::RG32F, glow::RG, size, &table) {
+            Ok(brdf) => brdf,
+            Err(e) => {
+                gl.delete_texture(atlas);
+                return Err(e);
+            }
+        };
+        Ok(GpuEnvironment {
+            atlas,
+            brdf,
+            rows,
+            sizes,
+        })
+    }
+}
+
 fn wrap(w: Wrap) -> i32 {
     (match w {
         Wrap::Repeat => glow::REPEAT,
@@ -233,6 +389,20 @@ impl GpuScene {
                     None => None,
                 };
                 gpu.emissive_samplers.push(emissive);
+                let mut pbr = [None; 3];
+                for (slot, binding) in pbr.iter_mut().zip(material.pbr_textures()) {
+                    if let Some(b) = binding {
+                        // SAFETY: forwarded caller's contract.
+                        *slot = Some(unsafe { create_sampler(gl, &b.sampler) }?);
+                    }
+                }
+                gpu.pbr_samplers.push(pbr);
+            }
+            if let (Shading::Pbr, Some(light)) = (scene.shading, &scene.environment) {
+                // SAFETY: forwarded caller's contract.
+                let e = unsafe { upload_environment(gl, &light.environment) }
+                    .map_err(|e| format!("environment: {e}"))?;
+                gpu.environment = Some(e);
             }
             Ok(())
         })();
@@ -268,6 +438,13 @@ impl GpuScene {
             for s in self.emissive_samplers.drain(..).flatten() {
                 gl.delete_sampler(s);
             }
+            for s in self.pbr_samplers.drain(..).flatten().flatten() {
+                gl.delete_sampler(s);
+            }
+            if let Some(e) = self.environment.take() {
+                gl.delete_texture(e.atlas);
+                gl.delete_texture(e.brdf);
+            }
         }
     }
 }
@@ -296,6 +473,35 @@ mod tests {
             &v[VERTEX_FLOATS..2 * VERTEX_FLOATS],
             &[1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0]
         );
+    }
+
+    #[test]
+    fn environment_atlas_stacks_the_levels_with_their_borders() {
+        let environment = Environment::studio();
+        let (width, height, texels, rows, sizes) = environment_atlas(&environment).expect("atlas");
+        let strides: Vec<usize> = environment
+            .levels
+            .iter()
+            .map(|l| l.stride() as usize)
+            .collect();
+        assert_eq!(width, strides.iter().copied().max().unwrap());
+        assert_eq!(height, strides.iter().sum::<usize>());
+        assert_eq!(texels.len(), width * height * 3);
+        for (k, level) in environment.levels.iter().enumerate() {
+            assert_eq!(sizes[k] as u32, level.size);
+            let stride = strides[k];
+            for (x, y) in [(0, 0), (stride - 1, 0), (3, stride - 1), (stride / 2, 1)] {
+                let at = ((rows[k] as usize + y) * width + x) * 3;
+                assert_eq!(
+                    texels[at..at + 3],
+                    level.texels[y * stride + x],
+                    "level {k} ({x}, {y})"
+                );
+            }
+        }
+        let mut broken = (*environment).clone();
+        broken.levels.pop();
+        assert!(environment_atlas(&broken).is_err());
     }
 
     #[test]

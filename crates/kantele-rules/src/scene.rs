@@ -251,7 +251,6 @@ pub struct PunctualLight {
     pub range: Option<f32>,
 }
 
-
 /// One draw: a mesh placed in the world by a node.
 #[derive(Clone, Debug)]
 pub struct Draw {

@@ -17,7 +17,10 @@ const BYTES_PER_TEXEL: u64 = 24;
 
 /// The prepared environment of `path`, read and prepared on first use and kept for the rest of
 /// the process (a run renders many scenes under one environment). Errors are one line.
-pub(crate) fn load_environment(path: &Path, budget: &mut Budget) -> Result<Arc<Environment>, String> {
+pub(crate) fn load_environment(
+    path: &Path,
+    budget: &mut Budget,
+) -> Result<Arc<Environment>, String> {
     static CACHE: OnceLock<Mutex<HashMap<PathBuf, Arc<Environment>>>> = OnceLock::new();
     let key = path.canonicalize().map_err(|e| e.to_string())?;
     let cache = CACHE.get_or_init(Default::default);

@@ -46,7 +46,9 @@ pub(crate) fn apply(
                 scene.lights.truncate(MAX_LIGHTS);
             }
             let environment = match &options.environment {
-                EnvironmentChoice::Default if scene.lights.is_empty() => Some(Environment::studio()),
+                EnvironmentChoice::Default if scene.lights.is_empty() => {
+                    Some(Environment::studio())
+                }
                 EnvironmentChoice::Default | EnvironmentChoice::None => None,
                 EnvironmentChoice::Studio => Some(Environment::studio()),
                 EnvironmentChoice::File(path) => Some(

@@ -1,5 +1,6 @@
 //! Kantele set against OpenGL (Mesa's llvmpipe through EGL): agreement on every scene,
-//! multisampling, near-plane precision, points and lines, loader features.
+//! multisampling, near-plane precision, points and lines, loader features; PBR shading against
+//! the rules evaluated directly.
 //!
 //! One test binary with a module per subject: a binary per file would compile the shared
 //! generic code and link every dependency into each (in a clean build, 31 test binaries took a
@@ -12,5 +13,6 @@ mod agreement;
 mod loader_features;
 mod multisample;
 mod near_plane;
+mod pbr;
 mod points_lines;
 mod render;

@@ -307,7 +307,10 @@ pub fn brdf_ab(n_dot_v: f32, roughness: f32) -> [f32; 2] {
 
 /// The `i`-th of `n` points of the Hammersley set.
 fn hammersley(i: u32, n: u32) -> Vec2 {
-    Vec2::new(i as f32 / n as f32, i.reverse_bits() as f32 * (1.0 / 4_294_967_296.0))
+    Vec2::new(
+        i as f32 / n as f32,
+        i.reverse_bits() as f32 * (1.0 / 4_294_967_296.0),
+    )
 }
 
 /// A half vector around +Z drawn from the GGX distribution of `alpha` at `xi`.
@@ -430,10 +433,7 @@ fn equirect_direction(x: u32, y: u32, width: u32, height: u32) -> Vec3 {
 fn equirect_coordinates(d: Vec3, width: u32, height: u32) -> Vec2 {
     let phi = d.x.atan2(-d.z).rem_euclid(2.0 * PI);
     let theta = d.y.clamp(-1.0, 1.0).acos();
-    Vec2::new(
-        phi / (2.0 * PI) * width as f32,
-        theta / PI * height as f32,
-    )
+    Vec2::new(phi / (2.0 * PI) * width as f32, theta / PI * height as f32)
 }
 
 /// Radiance of the built-in studio towards `d`.
@@ -545,10 +545,8 @@ impl Equirect {
                 let (x, y) = (i % size, i / size);
                 let mut sum = Vec3::ZERO;
                 for (sx, sy) in [(0.25, 0.25), (0.75, 0.25), (0.25, 0.75), (0.75, 0.75)] {
-                    let uv = Vec2::new(
-                        (x as f32 + sx) / size as f32,
-                        (y as f32 + sy) / size as f32,
-                    );
+                    let uv =
+                        Vec2::new((x as f32 + sx) / size as f32, (y as f32 + sy) / size as f32);
                     sum += self.sample(octahedral_decode(uv));
                 }
                 sum * 0.25
@@ -601,7 +599,9 @@ fn mip_chain(finest: &OctahedralLevel) -> Vec<OctahedralLevel> {
         let halved: Vec<Vec3> = (0..half * half)
             .map(|i| {
                 let (x, y) = (2 * (i % half), 2 * (i / half));
-                (inner[y * s + x] + inner[y * s + x + 1] + inner[(y + 1) * s + x]
+                (inner[y * s + x]
+                    + inner[y * s + x + 1]
+                    + inner[(y + 1) * s + x]
                     + inner[(y + 1) * s + x + 1])
                     * 0.25
             })

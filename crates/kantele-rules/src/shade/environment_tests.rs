@@ -45,7 +45,10 @@ fn brdf_table_is_an_albedo() {
     for j in 0..BRDF_TABLE_SIZE {
         for i in 0..BRDF_TABLE_SIZE {
             let [a, b] = brdf_table()[j * BRDF_TABLE_SIZE + i];
-            assert!(a >= 0.0 && b >= 0.0 && a + b <= 1.0 + 1e-3, "({i}, {j}): {a} {b}");
+            assert!(
+                a >= 0.0 && b >= 0.0 && a + b <= 1.0 + 1e-3,
+                "({i}, {j}): {a} {b}"
+            );
         }
     }
     let [a, b] = brdf_ab(0.9, 0.05);
@@ -80,7 +83,10 @@ fn prefiltering_spreads_a_spot_with_roughness() {
     let aside = Vec3::new(1.0, 0.0, -1.0).normalize();
     let mirror_centre = light.specular(spot, 0.0).x;
     let mirror_aside = light.specular(aside, 0.0).x;
-    assert!(mirror_centre > 5.0 && mirror_aside < 0.2, "{mirror_centre} {mirror_aside}");
+    assert!(
+        mirror_centre > 5.0 && mirror_aside < 0.2,
+        "{mirror_centre} {mirror_aside}"
+    );
     let rough_centre = light.specular(spot, 0.6).x;
     let rough_aside = light.specular(aside, 0.6).x;
     assert!(rough_centre < mirror_centre && rough_aside > mirror_aside);

@@ -340,10 +340,7 @@ fn punctual<L: Lanes>(
     alpha: L::F32,
 ) -> [L::F32; 3] {
     let (l, attenuation) = light_arrival(lanes, light, &s.position);
-    let h = normalize3(
-        lanes,
-        [view[0] + l[0], view[1] + l[1], view[2] + l[2]],
-    );
+    let h = normalize3(lanes, [view[0] + l[0], view[1] + l[1], view[2] + l[2]]);
     let n_dot_l = clamp01(lanes, dot3::<L>(&s.normal, &l));
     let n_dot_v = clamp01(lanes, dot3::<L>(&s.normal, view));
     let n_dot_h = clamp01(lanes, dot3::<L>(&s.normal, &h));
@@ -432,7 +429,12 @@ fn image_based<L: Lanes>(
 
 /// Exposure (`× scale`) and the tone map, per lane.
 #[inline(always)]
-pub fn tonemap<L: Lanes>(lanes: L, tonemap: Tonemap, exposure: f32, rgb: [L::F32; 3]) -> [L::F32; 3] {
+pub fn tonemap<L: Lanes>(
+    lanes: L,
+    tonemap: Tonemap,
+    exposure: f32,
+    rgb: [L::F32; 3],
+) -> [L::F32; 3] {
     let e = lanes.splat_f32(exposure);
     let rgb = [rgb[0] * e, rgb[1] * e, rgb[2] * e];
     match tonemap {
@@ -442,8 +444,8 @@ pub fn tonemap<L: Lanes>(lanes: L, tonemap: Tonemap, exposure: f32, rgb: [L::F32
             let f = |x: L::F32| {
                 let x = x.max(lanes.splat_f32(0.0));
                 let num = x * (lanes.splat_f32(2.51) * x + lanes.splat_f32(0.03));
-                let den = x * (lanes.splat_f32(2.43) * x + lanes.splat_f32(0.59))
-                    + lanes.splat_f32(0.14);
+                let den =
+                    x * (lanes.splat_f32(2.43) * x + lanes.splat_f32(0.59)) + lanes.splat_f32(0.14);
                 clamp01(lanes, num / den)
             };
             [f(rgb[0]), f(rgb[1]), f(rgb[2])]

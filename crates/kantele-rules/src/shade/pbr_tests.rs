@@ -22,7 +22,13 @@ fn lane0(v: [<Scalar as Lanes>::F32; 3]) -> Vec3 {
     Vec3::new(v[0].extract(0), v[1].extract(0), v[2].extract(0))
 }
 
-fn surface(base: Vec3, metallic: f32, roughness: f32, normal: Vec3, position: Vec3) -> Surface<Scalar> {
+fn surface(
+    base: Vec3,
+    metallic: f32,
+    roughness: f32,
+    normal: Vec3,
+    position: Vec3,
+) -> Surface<Scalar> {
     Surface {
         base: splat3(base),
         metallic: Scalar.splat_f32(metallic),
@@ -69,7 +75,11 @@ fn a_sphere_under_a_directional_light_matches_appendix_b() {
         tonemap: Tonemap::None,
     };
     let mut checked = 0;
-    for base in [Vec3::new(0.9, 0.5, 0.2), Vec3::splat(1.0), Vec3::splat(0.02)] {
+    for base in [
+        Vec3::new(0.9, 0.5, 0.2),
+        Vec3::splat(1.0),
+        Vec3::splat(0.02),
+    ] {
         for metallic in [0.0, 0.5, 1.0] {
             for roughness in [0.0, 0.1, 0.35, 0.7, 1.0] {
                 for i in 0..40 {
@@ -183,20 +193,31 @@ fn tone_maps_keep_range_and_order() {
 fn white_furnace() {
     let width = 64;
     let white = vec![Vec3::ONE; width * width / 2];
-    let environment = Environment::from_equirect(width as u32, width as u32 / 2, &white)
-        .expect("environment");
+    let environment =
+        Environment::from_equirect(width as u32, width as u32 / 2, &white).expect("environment");
     // Irradiance ÷ π of a uniform radiance-1 sky is 1 in every direction.
-    for n in [Vec3::X, Vec3::Y, -Vec3::Z, Vec3::new(0.3, -0.5, 0.8).normalize()] {
+    for n in [
+        Vec3::X,
+        Vec3::Y,
+        -Vec3::Z,
+        Vec3::new(0.3, -0.5, 0.8).normalize(),
+    ] {
         let light = EnvironmentLight {
             environment: std::sync::Arc::new(environment.clone()),
             intensity: 1.0,
             rotation: 0.4,
         };
         let e = lane0(light.irradiance_lanes(Scalar, &splat3(n)));
-        assert!((e - Vec3::ONE).abs().max_element() < 0.01, "irradiance {e} at {n}");
+        assert!(
+            (e - Vec3::ONE).abs().max_element() < 0.01,
+            "irradiance {e} at {n}"
+        );
         for roughness in [0.0, 0.3, 1.0] {
             let s = lane0(light.specular_lanes(Scalar, &splat3(n), Scalar.splat_f32(roughness)));
-            assert!((s - Vec3::ONE).abs().max_element() < 0.01, "specular {s} at {n}");
+            assert!(
+                (s - Vec3::ONE).abs().max_element() < 0.01,
+                "specular {s} at {n}"
+            );
         }
     }
     let lighting = PbrLighting {
@@ -235,7 +256,11 @@ fn white_furnace() {
                 "metal roughness {roughness} at {n}: {metal}, A + B = {}",
                 a + b
             );
-            assert!(a + b >= 0.3, "roughness {roughness}, NdotV {n_dot_v}: A + B = {}", a + b);
+            assert!(
+                a + b >= 0.3,
+                "roughness {roughness}, NdotV {n_dot_v}: A + B = {}",
+                a + b
+            );
         }
     }
 }

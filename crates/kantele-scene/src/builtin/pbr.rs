@@ -116,11 +116,7 @@ pub fn spheres() -> (Scene, SceneInfo) {
             });
             let index = materials.len() - 1;
             meshes.push(sphere(32, 48, index));
-            let at = Vec3::new(
-                (column as f32 - 2.0) * 2.3,
-                (row as f32 - 2.0) * 2.3,
-                0.0,
-            );
+            let at = Vec3::new((column as f32 - 2.0) * 2.3, (row as f32 - 2.0) * 2.3, 0.0);
             draws.push(draw(
                 index,
                 Mat4::from_translation(at),

@@ -10,9 +10,9 @@ use kantele_rules::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 use super::{named, Loader};
 use crate::accessor::BufferData;
 use crate::texture_util::{decode_within, image_size, placeholder, ImageError};
-use kantele_rules::shade::texture::ColorSpace;
 use crate::uri::read_uri;
 use crate::LoadError;
+use kantele_rules::shade::texture::ColorSpace;
 
 /// Which texture coordinates a material's textures read: a `TEXCOORD_n` set and a
 /// `KHR_texture_transform` (applied to the mesh's coordinates at load).
@@ -121,7 +121,12 @@ impl Loader<'_> {
         }
         if let Some(info) = pbr.metallic_roughness_texture() {
             let uv = UvMap::of(info.tex_coord(), info.extension_value(transform));
-            refs.push((TextureSlot::MetallicRoughness, info.texture(), ColorSpace::Linear, uv));
+            refs.push((
+                TextureSlot::MetallicRoughness,
+                info.texture(),
+                ColorSpace::Linear,
+                uv,
+            ));
         }
         if let Some(t) = material.normal_texture() {
             let uv = UvMap::of(t.tex_coord(), t.extension_value(transform));
@@ -315,7 +320,11 @@ impl Loader<'_> {
         };
         if !self.options.decode_textures {
             // Describing the scene: the header's size is reported, nothing is decoded.
-            return Ok(Some(self.push_texture(placeholder(), (bytes, color_space), size)));
+            return Ok(Some(self.push_texture(
+                placeholder(),
+                (bytes, color_space),
+                size,
+            )));
         }
         match decode_within(&bytes, mime_type.as_deref(), color_space, &mut self.budget) {
             Ok(texture) => Ok(Some(self.push_texture(texture, (bytes, color_space), size))),

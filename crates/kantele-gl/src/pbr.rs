@@ -1,0 +1,719 @@
+//! The PBR program: glTF metallic-roughness shading (`kantele_rules::shade::pbr`) written in
+//! GLSL 3.30 operation for operation — the same formulas, the same order, the same clamps —
+//! its uniform locations, and the per-frame and per-draw uniforms it reads. The Lambert program
+//! of [`crate::shaders`] is untouched; a frame uses this one when its scene's
+//! [`Shading`](kantele_rules::scene::Shading) is `Pbr`.
+//!
+//! The environment ([`EnvironmentLight`]) is read with the arithmetic of
+//! `kantele_rules::shade::environment`: nine SH coefficients for irradiance, and the six
+//! pre-filtered octahedral levels and the split-sum table read by `texelFetch` with the bilinear
+//! weights computed in the shader as the CPU computes them (never GL's filtering). The levels
+//! share one `GL_RGB32F` atlas, stacked from level 0 at row 0 (see
+//! [`crate::resources::GpuEnvironment`]).
+
+use glam::Vec3;
+use glow::HasContext;
+use kantele_rules::shade::environment::{EnvironmentLight, BRDF_TABLE_SIZE, SPECULAR_LEVELS};
+use kantele_rules::shade::pbr::{
+    FrameLight, PbrLighting, Tonemap, DIELECTRIC_F0, MAX_LIGHTS, MIN_PUNCTUAL_ROUGHNESS,
+};
+
+use crate::program::{uniforms, Uniforms};
+use crate::resources::GpuEnvironment;
+
+/// Texture unit of the metallic-roughness texture (0 and 1 are the base colour and emissive).
+pub(crate) const UNIT_METALLIC_ROUGHNESS: u32 = 2;
+/// Texture unit of the normal texture.
+pub(crate) const UNIT_NORMAL: u32 = 3;
+/// Texture unit of the occlusion texture.
+pub(crate) const UNIT_OCCLUSION: u32 = 4;
+/// Texture unit of the environment's level atlas.
+pub(crate) const UNIT_ENVIRONMENT: u32 = 5;
+/// Texture unit of the split-sum table.
+pub(crate) const UNIT_BRDF: u32 = 6;
+
+/// The vertex shader: the Lambert program's, plus the world position for the fragment shader.
+pub(crate) const VERTEX: &str = r#"#version 330 core
+layout(location = 0) in vec3 a_position;
+layout(location = 1) in vec3 a_normal;
+layout(location = 2) in vec2 a_texcoord;
+layout(location = 3) in vec4 a_color;
+
+// y-flipped projection × view × model (window row 0 = image row 0).
+uniform mat4 u_model_view_projection;
+// Inverse transpose of the model matrix's upper 3 × 3.
+uniform mat3 u_normal_matrix;
+// The draw's model matrix (world position).
+uniform mat4 u_model;
+
+out vec3 v_normal;
+out vec2 v_texcoord;
+out vec4 v_color;
+out vec3 v_position;
+
+void main() {
+    gl_Position = u_model_view_projection * vec4(a_position, 1.0);
+    v_normal = u_normal_matrix * a_normal;
+    v_texcoord = a_texcoord;
+    v_color = a_color;
+    v_position = (u_model * vec4(a_position, 1.0)).xyz;
+}
+"#;
+
+/// The fragment shader after its constants (see [`fragment_source`]).
+const FRAGMENT_BODY: &str = r#"
+in vec3 v_normal;
+in vec2 v_texcoord;
+in vec4 v_color;
+in vec3 v_position;
+
+// Spherical harmonics of bands 0-2 (environment.rs: SH_Y0, SH_Y1, SH_Y2, SH_Y20, SH_Y22).
+const float SH_Y0 = 0.2820948;
+const float SH_Y1 = 0.4886025;
+const float SH_Y2 = 1.0925484;
+const float SH_Y20 = 0.31539157;
+const float SH_Y22 = 0.5462742;
+
+uniform vec4 u_base_color_factor;
+uniform bool u_has_texture;
+uniform sampler2D u_base_color_texture;
+uniform vec3 u_emissive;        // linear emitted colour, added after lighting
+uniform bool u_has_emissive_texture;
+uniform sampler2D u_emissive_texture;
+uniform bool u_unlit;
+uniform int u_alpha_mode;      // 0 opaque, 1 mask, 2 blend
+uniform float u_alpha_cutoff;
+uniform bool u_double_sided;
+uniform int u_pass;            // 0 colour, 1 normals, 2 ids
+uniform vec2 u_ids;            // node index + 1, draw index + 1
+
+uniform float u_metallic;
+uniform float u_roughness;
+uniform bool u_has_metallic_roughness_texture;
+uniform sampler2D u_metallic_roughness_texture;
+uniform bool u_has_normal_texture;
+uniform sampler2D u_normal_texture;
+uniform float u_normal_scale;
+uniform bool u_has_occlusion_texture;
+uniform sampler2D u_occlusion_texture;
+uniform float u_occlusion_strength;
+
+// PbrLighting: the eye, the punctual lights (FrameLight, as u_punctual_*: u_light_color is
+// the Lambert program's), exposure scale and tone map.
+uniform vec3 u_eye;
+uniform int u_punctual_count;
+uniform vec3 u_punctual_color[MAX_LIGHTS];
+uniform vec3 u_punctual_direction[MAX_LIGHTS];
+uniform vec3 u_punctual_position[MAX_LIGHTS];
+uniform bool u_punctual_directional[MAX_LIGHTS];
+uniform float u_punctual_inverse_range_squared[MAX_LIGHTS];
+uniform float u_punctual_cone_scale[MAX_LIGHTS];
+uniform float u_punctual_cone_offset[MAX_LIGHTS];
+uniform float u_exposure;
+uniform int u_tonemap;         // 0 none, 1 PBR Neutral, 2 ACES
+
+// EnvironmentLight.
+uniform bool u_has_environment;
+uniform float u_environment_intensity;
+uniform vec2 u_environment_rotation;  // (sin, cos) of lookup_rotation()
+uniform vec3 u_irradiance_sh[9];
+uniform sampler2D u_environment;      // the levels, stacked (RGB32F, texelFetch only)
+uniform int u_level_row[LEVELS];      // first atlas row of each level
+uniform int u_level_size[LEVELS];     // each level's size without its border
+uniform sampler2D u_brdf;             // split-sum (A, B), RG32F, texelFetch only
+
+layout(location = 0) out vec4 o_color;
+
+bool is_finite(float x) {
+    return !isnan(x) && !isinf(x);
+}
+
+float clamp01(float x) {
+    return min(max(x, 0.0), 1.0);
+}
+
+float dot3(vec3 a, vec3 b) {
+    return a.x * b.x + a.y * b.y + a.z * b.z;
+}
+
+// pbr::normalize3: v / |v|, zero where |v| is zero or not finite.
+vec3 normalize3(vec3 v) {
+    float length2 = dot3(v, v);
+    float rcp = 1.0 / sqrt(length2);
+    bool usable = length2 > 0.0 && rcp > 0.0 && !isinf(rcp);
+    return usable ? v * rcp : vec3(0.0);
+}
+
+// pbr::ggx_d_times_v.
+float ggx_d_times_v(float alpha, float n_dot_l, float n_dot_v, float n_dot_h) {
+    float a2 = alpha * alpha;
+    float f = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
+    float d = a2 / (PI * f * f);
+    float ggx_v = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
+    float ggx_l = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2);
+    float denominator = ggx_v + ggx_l;
+    float v = denominator > 0.0 ? 0.5 / denominator : 0.0;
+    return d * v;
+}
+
+// pbr::schlick.
+vec3 schlick(vec3 f0, float v_dot_h) {
+    float m = 1.0 - v_dot_h;
+    float m2 = m * m;
+    float m5 = m2 * m2 * m;
+    return f0 + (1.0 - f0) * m5;
+}
+
+// pbr::light_arrival: the unit vector towards light i and the attenuation.
+void light_arrival(int i, vec3 position, out vec3 l, out float attenuation) {
+    if (u_punctual_directional[i]) {
+        l = u_punctual_direction[i];
+        attenuation = 1.0;
+        return;
+    }
+    vec3 d = u_punctual_position[i] - position;
+    float distance2 = dot3(d, d);
+    l = normalize3(d);
+    float a = 1.0 / distance2;
+    if (u_punctual_inverse_range_squared[i] > 0.0) {
+        float ratio2 = distance2 * u_punctual_inverse_range_squared[i];
+        a = a * clamp01(1.0 - ratio2 * ratio2);
+    }
+    if (u_punctual_cone_scale[i] > 0.0) {
+        vec3 axis = u_punctual_direction[i];
+        float cos_angle = -(l.x * axis.x + l.y * axis.y + l.z * axis.z);
+        float cone = clamp01(cos_angle * u_punctual_cone_scale[i] + u_punctual_cone_offset[i]);
+        a = a * cone * cone;
+    }
+    // A surface at the light's position receives nothing (not infinity).
+    attenuation = is_finite(a) ? a : 0.0;
+}
+
+// pbr::punctual.
+vec3 punctual(int i, vec3 n, vec3 position, vec3 view, vec3 c_diff, vec3 f0, float alpha) {
+    vec3 l;
+    float attenuation;
+    light_arrival(i, position, l, attenuation);
+    vec3 h = normalize3(view + l);
+    float n_dot_l = clamp01(dot3(n, l));
+    float n_dot_v = clamp01(dot3(n, view));
+    float n_dot_h = clamp01(dot3(n, h));
+    float v_dot_h = clamp01(dot3(view, h));
+    vec3 f = schlick(f0, v_dot_h);
+    float dv = ggx_d_times_v(alpha, n_dot_l, n_dot_v, n_dot_h);
+    float scale = attenuation * n_dot_l;
+    vec3 brdf = (1.0 - f) * c_diff * INV_PI + f * dv;
+    return u_punctual_color[i] * scale * brdf;
+}
+
+// EnvironmentLight::irradiance_lanes: irradiance / pi at the unit normal n.
+vec3 irradiance(vec3 n) {
+    float s = u_environment_rotation.x;
+    float c = u_environment_rotation.y;
+    float x = c * n.x + s * n.z;
+    float y = n.y;
+    float z = c * n.z - s * n.x;
+    float basis[9] = float[9](
+        SH_Y0,
+        SH_Y1 * y,
+        SH_Y1 * z,
+        SH_Y1 * x,
+        SH_Y2 * x * y,
+        SH_Y2 * y * z,
+        SH_Y20 * (3.0 * z * z - 1.0),
+        SH_Y2 * x * z,
+        SH_Y22 * (x * x - y * y)
+    );
+    vec3 sum = vec3(0.0);
+    for (int i = 0; i < 9; i++) {
+        sum = sum + u_irradiance_sh[i] * basis[i];
+    }
+    return max(sum, vec3(0.0));
+}
+
+float sign_of(float v) {
+    return v >= 0.0 ? 1.0 : -1.0;
+}
+
+// environment::octahedral_encode.
+vec2 octahedral_encode(vec3 d) {
+    float sum = abs(d.x) + abs(d.y) + abs(d.z);
+    vec2 p = sum > 0.0 ? vec2(d.x / sum, d.y / sum) : vec2(0.0);
+    if (d.z < 0.0) {
+        p = vec2((1.0 - abs(p.y)) * sign_of(p.x), (1.0 - abs(p.x)) * sign_of(p.y));
+    }
+    return p * 0.5 + 0.5;
+}
+
+vec3 level_texel(int level, int x, int y) {
+    return texelFetch(u_environment, ivec2(x, u_level_row[level] + y), 0).rgb;
+}
+
+// OctahedralLevel::sample: bilinear inside level `level` at unit direction d.
+vec3 level_sample(int level, vec3 d) {
+    vec2 uv = octahedral_encode(d);
+    float size = float(u_level_size[level]);
+    // Texel centre i sits at (i + 0.5) / size; the border shifts indices by one.
+    float x = clamp(uv.x * size + 0.5, 0.0, size + 1.0);
+    float y = clamp(uv.y * size + 0.5, 0.0, size + 1.0);
+    float x0f = floor(x);
+    float y0f = floor(y);
+    float fx = x - x0f;
+    float fy = y - y0f;
+    int stride = u_level_size[level] + 2;
+    int x0 = int(x0f);
+    int y0 = int(y0f);
+    int x1 = min(x0 + 1, stride - 1);
+    int y1 = min(y0 + 1, stride - 1);
+    vec3 t00 = level_texel(level, x0, y0);
+    vec3 t10 = level_texel(level, x1, y0);
+    vec3 t01 = level_texel(level, x0, y1);
+    vec3 t11 = level_texel(level, x1, y1);
+    vec3 top = t00 + (t10 - t00) * fx;
+    vec3 bottom = t01 + (t11 - t01) * fx;
+    return top + (bottom - top) * fy;
+}
+
+// EnvironmentLight::specular: pre-filtered radiance along r (need not be unit).
+vec3 specular(vec3 r, float roughness) {
+    float s = u_environment_rotation.x;
+    float c = u_environment_rotation.y;
+    vec3 d = normalize3(vec3(c * r.x + s * r.z, r.y, -s * r.x + c * r.z));
+    float last = float(LEVELS - 1);
+    float lod = is_finite(roughness) ? clamp(roughness * last, 0.0, last) : last;
+    float level = floor(lod);
+    float t = lod - level;
+    int k = int(level);
+    vec3 lo = level_sample(k, d);
+    if (t == 0.0) {
+        return lo;
+    }
+    vec3 hi = level_sample(min(k + 1, LEVELS - 1), d);
+    return lo + (hi - lo) * t;
+}
+
+float brdf_coordinate(float v) {
+    float n = float(BRDF_TABLE_SIZE);
+    v = is_finite(v) ? v : 1.0;
+    return clamp(v * n - 0.5, 0.0, n - 1.0);
+}
+
+// environment::brdf_ab: (A, B) read bilinearly from the table (clamped to its cell centres).
+vec2 brdf_ab(float n_dot_v, float roughness) {
+    float x = brdf_coordinate(n_dot_v);
+    float y = brdf_coordinate(roughness);
+    float x0f = floor(x);
+    float y0f = floor(y);
+    float fx = x - x0f;
+    float fy = y - y0f;
+    int x0 = int(x0f);
+    int y0 = int(y0f);
+    int x1 = min(x0 + 1, BRDF_TABLE_SIZE - 1);
+    int y1 = min(y0 + 1, BRDF_TABLE_SIZE - 1);
+    vec2 t00 = texelFetch(u_brdf, ivec2(x0, y0), 0).rg;
+    vec2 t10 = texelFetch(u_brdf, ivec2(x1, y0), 0).rg;
+    vec2 t01 = texelFetch(u_brdf, ivec2(x0, y1), 0).rg;
+    vec2 t11 = texelFetch(u_brdf, ivec2(x1, y1), 0).rg;
+    vec2 top = t00 + (t10 - t00) * fx;
+    vec2 bottom = t01 + (t11 - t01) * fx;
+    return top + (bottom - top) * fy;
+}
+
+// pbr::image_based.
+vec3 image_based(vec3 n, vec3 view, vec3 c_diff, vec3 f0, float roughness, float occlusion) {
+    float n_dot_v_raw = dot3(n, view);
+    float n_dot_v = clamp01(n_dot_v_raw);
+    // R = 2 (N.V) N - V.
+    float two_n_dot_v = n_dot_v_raw + n_dot_v_raw;
+    vec3 reflected = two_n_dot_v * n - view;
+    vec3 irradiance_ = irradiance(n);
+    vec3 specular_ = specular(reflected, roughness);
+    vec2 ab = brdf_ab(n_dot_v, roughness);
+    float weight = occlusion * u_environment_intensity;
+    vec3 fss_ess = f0 * ab.x + ab.y;
+    vec3 diffuse = irradiance_ * c_diff * (1.0 - fss_ess);
+    return (diffuse + specular_ * fss_ess) * weight;
+}
+
+// pbr::shade: the linear colour before exposure and tone mapping.
+vec3 shade(vec3 base, float metallic, float roughness, float occlusion, vec3 n, vec3 position) {
+    vec3 view = normalize3(u_eye - position);
+    float dielectric = 1.0 - metallic;
+    vec3 c_diff = base * dielectric;
+    vec3 f0 = DIELECTRIC_F0 + (base - DIELECTRIC_F0) * metallic;
+    float clamped = max(roughness, MIN_PUNCTUAL_ROUGHNESS);
+    float alpha = clamped * clamped;
+    vec3 color = vec3(0.0);
+    for (int i = 0; i < u_punctual_count; i++) {
+        color = color + punctual(i, n, position, view, c_diff, f0, alpha);
+    }
+    if (u_has_environment) {
+        color = color + image_based(n, view, c_diff, f0, roughness, occlusion);
+    }
+    return color;
+}
+
+// pbr::pbr_neutral (Khronos PBR Neutral).
+vec3 pbr_neutral(vec3 rgb) {
+    const float DESATURATION = 0.15;
+    float x = min(rgb.r, min(rgb.g, rgb.b));
+    float toe = x - 6.25 * x * x;
+    float toe_offset = x < 0.08 ? toe : 0.04;
+    vec3 c = rgb - toe_offset;
+    float peak = max(c.r, max(c.g, c.b));
+    float d = 1.0 - START_COMPRESSION;
+    float new_peak = 1.0 - (d * d) / (peak + (d - START_COMPRESSION));
+    float ratio = new_peak / peak;
+    float g = 1.0 - 1.0 / (DESATURATION * (peak - new_peak) + 1.0);
+    vec3 scaled = c * ratio;
+    vec3 mixed = scaled + (new_peak - scaled) * g;
+    return peak >= START_COMPRESSION ? mixed : c;
+}
+
+float aces(float x) {
+    x = max(x, 0.0);
+    float num = x * (2.51 * x + 0.03);
+    float den = x * (2.43 * x + 0.59) + 0.14;
+    return clamp01(num / den);
+}
+
+// pbr::tonemap: exposure, then the tone map.
+vec3 tonemap(vec3 rgb) {
+    rgb = rgb * u_exposure;
+    if (u_tonemap == 1) {
+        return pbr_neutral(rgb);
+    }
+    if (u_tonemap == 2) {
+        return vec3(aces(rgb.r), aces(rgb.g), aces(rgb.b));
+    }
+    return rgb;
+}
+
+void main() {
+    // Every texture and derivative is read here, in uniform control flow, before any discard.
+    // Texels are kantele's 8-bit mip chains (SRGB8_ALPHA8 or RGBA8), decoded to linear by GL.
+    vec4 base = u_base_color_factor * v_color;
+    if (u_has_texture) {
+        base *= texture(u_base_color_texture, v_texcoord);
+    }
+    vec4 metallic_roughness = vec4(1.0);
+    if (u_has_metallic_roughness_texture) {
+        metallic_roughness = texture(u_metallic_roughness_texture, v_texcoord);
+    }
+    vec4 occlusion_texel = vec4(1.0);
+    if (u_has_occlusion_texture) {
+        occlusion_texel = texture(u_occlusion_texture, v_texcoord);
+    }
+    vec4 normal_texel = vec4(0.5, 0.5, 1.0, 1.0);
+    if (u_has_normal_texture) {
+        normal_texel = texture(u_normal_texture, v_texcoord);
+    }
+    vec3 emissive = u_emissive;
+    if (u_has_emissive_texture) {
+        emissive *= texture(u_emissive_texture, v_texcoord).rgb;
+    }
+    // The projection is y-flipped (window row 0 = image row 0), so dFdy is the derivative
+    // towards increasing image row, as the CPU's.
+    vec3 dp_dx = dFdx(v_position);
+    vec3 dp_dy = dFdy(v_position);
+    vec2 duv_dx = dFdx(v_texcoord);
+    vec2 duv_dy = dFdy(v_texcoord);
+
+    if (u_alpha_mode == 1 && base.a < u_alpha_cutoff) {
+        discard;
+    }
+
+    float metallic = u_metallic;
+    float roughness = u_roughness;
+    if (u_has_metallic_roughness_texture) {
+        metallic = u_metallic * metallic_roughness.b;
+        roughness = u_roughness * metallic_roughness.g;
+    }
+    metallic = clamp(metallic, 0.0, 1.0);
+    roughness = clamp(roughness, 0.0, 1.0);
+    float occlusion = 1.0;
+    if (u_has_occlusion_texture) {
+        occlusion = 1.0 + u_occlusion_strength * (occlusion_texel.r - 1.0);
+    }
+
+    vec3 ng = normalize3(v_normal);
+    vec3 n = ng;
+    if (u_has_normal_texture) {
+        // The tangent from the screen-space derivatives of position and texture coordinate.
+        float du_dx = duv_dx.x;
+        float dv_dx = duv_dx.y;
+        float du_dy = duv_dy.x;
+        float dv_dy = duv_dy.y;
+        vec3 t_ = (dv_dy * dp_dx - dv_dx * dp_dy) / (du_dx * dv_dy - du_dy * dv_dx);
+        vec3 t = normalize3(t_ - ng * dot3(ng, t_));
+        // A degenerate mapping (t zero or not finite) keeps the geometric normal.
+        if (t != vec3(0.0)) {
+            vec3 b = cross(ng, t);
+            vec3 m = normal_texel.rgb * 2.0 - 1.0;
+            m.x = m.x * u_normal_scale;
+            m.y = m.y * u_normal_scale;
+            n = normalize3(t * m.x + b * m.y + ng * m.z);
+        }
+    }
+    // The projection is y-flipped and glFrontFace is GL_CW, so gl_FrontFacing keeps its meaning:
+    // true for triangles counter-clockwise in (unflipped) NDC.
+    if (u_double_sided && !gl_FrontFacing) {
+        n = -n;
+    }
+    if (u_pass == 1) {
+        o_color = vec4(n, 1.0);
+        return;
+    }
+    if (u_pass == 2) {
+        o_color = vec4(u_ids.x, float(gl_PrimitiveID + 1), u_ids.y, 1.0);
+        return;
+    }
+    vec3 rgb;
+    if (u_unlit) {
+        rgb = base.rgb + emissive;
+    } else {
+        rgb = shade(base.rgb, metallic, roughness, occlusion, n, v_position) + emissive;
+    }
+    rgb = tonemap(rgb);
+    float a = u_alpha_mode == 2 ? base.a : 1.0;
+    o_color = vec4(rgb, a);
+}
+"#;
+
+/// The fragment shader: the rules' constants (formatted from `kantele_rules`, so each is written
+/// once), then the shading.
+pub(crate) fn fragment_source() -> String {
+    // Debug formatting of an f32 is the shortest decimal that reads back as the same f32.
+    let float = |name: &str, value: f32| format!("const float {name} = {value:?};\n");
+    let int = |name: &str, value: usize| format!("const int {name} = {value};\n");
+    let mut source = String::from("#version 330 core\n");
+    source += &int("MAX_LIGHTS", MAX_LIGHTS);
+    source += &int("LEVELS", SPECULAR_LEVELS);
+    source += &int("BRDF_TABLE_SIZE", BRDF_TABLE_SIZE);
+    source += &float("PI", std::f32::consts::PI);
+    source += &float("INV_PI", std::f32::consts::FRAC_1_PI);
+    source += &float("DIELECTRIC_F0", DIELECTRIC_F0);
+    source += &float("MIN_PUNCTUAL_ROUGHNESS", MIN_PUNCTUAL_ROUGHNESS);
+    // pbr_neutral's START_COMPRESSION, 0.8 − 0.04 rounded as f32.
+    source += &float("START_COMPRESSION", 0.8f32 - 0.04f32);
+    source += FRAGMENT_BODY;
+    source
+}
+
+/// `u_tonemap`'s value for a tone map.
+fn tonemap_index(tonemap: Tonemap) -> i32 {
+    match tonemap {
+        Tonemap::None => 0,
+        Tonemap::PbrNeutral => 1,
+        Tonemap::Aces => 2,
+    }
+}
+
+/// Uniform locations of the PBR program.
+pub(crate) struct PbrUniforms {
+    /// The uniforms it shares with the Lambert program (the Lambert light and ambient are
+    /// `None`).
+    pub(crate) common: Uniforms,
+    pub(crate) model: Option<glow::UniformLocation>,
+    pub(crate) metallic: Option<glow::UniformLocation>,
+    pub(crate) roughness: Option<glow::UniformLocation>,
+    pub(crate) has_metallic_roughness_texture: Option<glow::UniformLocation>,
+    pub(crate) metallic_roughness_texture: Option<glow::UniformLocation>,
+    pub(crate) has_normal_texture: Option<glow::UniformLocation>,
+    pub(crate) normal_texture: Option<glow::UniformLocation>,
+    pub(crate) normal_scale: Option<glow::UniformLocation>,
+    pub(crate) has_occlusion_texture: Option<glow::UniformLocation>,
+    pub(crate) occlusion_texture: Option<glow::UniformLocation>,
+    pub(crate) occlusion_strength: Option<glow::UniformLocation>,
+    pub(crate) eye: Option<glow::UniformLocation>,
+    pub(crate) light_count: Option<glow::UniformLocation>,
+    pub(crate) light_color: Option<glow::UniformLocation>,
+    pub(crate) light_direction: Option<glow::UniformLocation>,
+    pub(crate) light_position: Option<glow::UniformLocation>,
+    pub(crate) light_directional: Option<glow::UniformLocation>,
+    pub(crate) light_inverse_range_squared: Option<glow::UniformLocation>,
+    pub(crate) light_cone_scale: Option<glow::UniformLocation>,
+    pub(crate) light_cone_offset: Option<glow::UniformLocation>,
+    pub(crate) exposure: Option<glow::UniformLocation>,
+    pub(crate) tonemap: Option<glow::UniformLocation>,
+    pub(crate) has_environment: Option<glow::UniformLocation>,
+    pub(crate) environment_intensity: Option<glow::UniformLocation>,
+    pub(crate) environment_rotation: Option<glow::UniformLocation>,
+    pub(crate) irradiance_sh: Option<glow::UniformLocation>,
+    pub(crate) environment: Option<glow::UniformLocation>,
+    pub(crate) level_row: Option<glow::UniformLocation>,
+    pub(crate) level_size: Option<glow::UniformLocation>,
+    pub(crate) brdf: Option<glow::UniformLocation>,
+}
+
+/// Looks up every uniform of the PBR program.
+///
+/// # Safety
+/// `gl` must be current on this thread and `program` the linked PBR program of it.
+pub(crate) unsafe fn pbr_uniforms(gl: &glow::Context, program: glow::Program) -> PbrUniforms {
+    // SAFETY: caller's contract.
+    let at = |name: &str| unsafe { gl.get_uniform_location(program, name) };
+    PbrUniforms {
+        // The Lambert light and ambient are not the PBR program's (its lights are named
+        // u_punctual_*): none, whatever the program declares.
+        common: Uniforms {
+            to_light: None,
+            light_color: None,
+            ambient: None,
+            // SAFETY: caller's contract.
+            ..unsafe { uniforms(gl, program) }
+        },
+        model: at("u_model"),
+        metallic: at("u_metallic"),
+        roughness: at("u_roughness"),
+        has_metallic_roughness_texture: at("u_has_metallic_roughness_texture"),
+        metallic_roughness_texture: at("u_metallic_roughness_texture"),
+        has_normal_texture: at("u_has_normal_texture"),
+        normal_texture: at("u_normal_texture"),
+        normal_scale: at("u_normal_scale"),
+        has_occlusion_texture: at("u_has_occlusion_texture"),
+        occlusion_texture: at("u_occlusion_texture"),
+        occlusion_strength: at("u_occlusion_strength"),
+        eye: at("u_eye"),
+        light_count: at("u_punctual_count"),
+        light_color: at("u_punctual_color"),
+        light_direction: at("u_punctual_direction"),
+        light_position: at("u_punctual_position"),
+        light_directional: at("u_punctual_directional"),
+        light_inverse_range_squared: at("u_punctual_inverse_range_squared"),
+        light_cone_scale: at("u_punctual_cone_scale"),
+        light_cone_offset: at("u_punctual_cone_offset"),
+        exposure: at("u_exposure"),
+        tonemap: at("u_tonemap"),
+        has_environment: at("u_has_environment"),
+        environment_intensity: at("u_environment_intensity"),
+        environment_rotation: at("u_environment_rotation"),
+        irradiance_sh: at("u_irradiance_sh"),
+        environment: at("u_environment"),
+        level_row: at("u_level_row"),
+        level_size: at("u_level_size"),
+        brdf: at("u_brdf"),
+    }
+}
+
+/// The punctual lights as the shader's uniform arrays, [`MAX_LIGHTS`] long (unused entries
+/// zero).
+struct LightArrays {
+    count: i32,
+    color: Vec<f32>,
+    direction: Vec<f32>,
+    position: Vec<f32>,
+    directional: Vec<i32>,
+    inverse_range_squared: Vec<f32>,
+    cone_scale: Vec<f32>,
+    cone_offset: Vec<f32>,
+}
+
+impl LightArrays {
+    fn new(lights: &[FrameLight]) -> Self {
+        let lights = &lights[..lights.len().min(MAX_LIGHTS)];
+        let vec3s = |f: &dyn Fn(&FrameLight) -> Vec3| {
+            let mut v: Vec<f32> = lights.iter().flat_map(|l| f(l).to_array()).collect();
+            v.resize(3 * MAX_LIGHTS, 0.0);
+            v
+        };
+        let floats = |f: &dyn Fn(&FrameLight) -> f32| {
+            let mut v: Vec<f32> = lights.iter().map(f).collect();
+            v.resize(MAX_LIGHTS, 0.0);
+            v
+        };
+        let mut directional: Vec<i32> = lights.iter().map(|l| l.directional as i32).collect();
+        directional.resize(MAX_LIGHTS, 0);
+        Self {
+            count: lights.len() as i32,
+            color: vec3s(&|l| l.color),
+            direction: vec3s(&|l| l.direction),
+            position: vec3s(&|l| l.position),
+            directional,
+            inverse_range_squared: floats(&|l| l.inverse_range_squared),
+            cone_scale: floats(&|l| l.cone_scale),
+            cone_offset: floats(&|l| l.cone_offset),
+        }
+    }
+}
+
+/// Sets the frame's uniforms of the PBR program (in use): texture units, the eye, the lights,
+/// exposure and tone map, and the environment, whose atlas and table it binds to
+/// [`UNIT_ENVIRONMENT`] and [`UNIT_BRDF`] (leaving unit 0 active).
+///
+/// # Safety
+/// `gl` must be current on this thread with the PBR program in use; `environment` must be
+/// its objects.
+pub(crate) unsafe fn set_frame_uniforms(
+    gl: &glow::Context,
+    u: &PbrUniforms,
+    lighting: &PbrLighting,
+    environment: Option<&GpuEnvironment>,
+) {
+    let lights = LightArrays::new(&lighting.lights);
+    let unit = |unit: u32| unit as i32;
+    // SAFETY: caller's contract; every slice has the length of its uniform array.
+    unsafe {
+        gl.uniform_1_i32(
+            u.metallic_roughness_texture.as_ref(),
+            unit(UNIT_METALLIC_ROUGHNESS),
+        );
+        gl.uniform_1_i32(u.normal_texture.as_ref(), unit(UNIT_NORMAL));
+        gl.uniform_1_i32(u.occlusion_texture.as_ref(), unit(UNIT_OCCLUSION));
+        gl.uniform_1_i32(u.environment.as_ref(), unit(UNIT_ENVIRONMENT));
+        gl.uniform_1_i32(u.brdf.as_ref(), unit(UNIT_BRDF));
+        gl.uniform_3_f32_slice(u.eye.as_ref(), &lighting.eye.to_array());
+        gl.uniform_1_i32(u.light_count.as_ref(), lights.count);
+        gl.uniform_3_f32_slice(u.light_color.as_ref(), &lights.color);
+        gl.uniform_3_f32_slice(u.light_direction.as_ref(), &lights.direction);
+        gl.uniform_3_f32_slice(u.light_position.as_ref(), &lights.position);
+        gl.uniform_1_i32_slice(u.light_directional.as_ref(), &lights.directional);
+        gl.uniform_1_f32_slice(
+            u.light_inverse_range_squared.as_ref(),
+            &lights.inverse_range_squared,
+        );
+        gl.uniform_1_f32_slice(u.light_cone_scale.as_ref(), &lights.cone_scale);
+        gl.uniform_1_f32_slice(u.light_cone_offset.as_ref(), &lights.cone_offset);
+        gl.uniform_1_f32(u.exposure.as_ref(), lighting.exposure);
+        gl.uniform_1_i32(u.tonemap.as_ref(), tonemap_index(lighting.tonemap));
+        let light_and_maps = lighting.environment.as_ref().zip(environment);
+        gl.uniform_1_i32(u.has_environment.as_ref(), light_and_maps.is_some() as i32);
+        gl.active_texture(glow::TEXTURE0 + UNIT_ENVIRONMENT);
+        gl.bind_sampler(UNIT_ENVIRONMENT, None);
+        gl.bind_texture(glow::TEXTURE_2D, environment.map(|e| e.atlas));
+        gl.active_texture(glow::TEXTURE0 + UNIT_BRDF);
+        gl.bind_sampler(UNIT_BRDF, None);
+        gl.bind_texture(glow::TEXTURE_2D, environment.map(|e| e.brdf));
+        gl.active_texture(glow::TEXTURE0);
+        if let Some((light, maps)) = light_and_maps {
+            set_environment_uniforms(gl, u, light, maps);
+        }
+    }
+}
+
+/// The environment's uniforms: intensity, lookup rotation, SH coefficients, level layout.
+///
+/// # Safety
+/// As [`set_frame_uniforms`].
+unsafe fn set_environment_uniforms(
+    gl: &glow::Context,
+    u: &PbrUniforms,
+    light: &EnvironmentLight,
+    maps: &GpuEnvironment,
+) {
+    let (sin, cos) = light.lookup_rotation();
+    let sh: Vec<f32> = light
+        .environment
+        .irradiance_sh
+        .iter()
+        .flat_map(|c| c.to_array())
+        .collect();
+    // SAFETY: caller's contract; the slices have their uniform arrays' lengths.
+    unsafe {
+        gl.uniform_1_f32(u.environment_intensity.as_ref(), light.intensity);
+        gl.uniform_2_f32(u.environment_rotation.as_ref(), sin, cos);
+        gl.uniform_3_f32_slice(u.irradiance_sh.as_ref(), &sh);
+        gl.uniform_1_i32_slice(u.level_row.as_ref(), &maps.rows);
+        gl.uniform_1_i32_slice(u.level_size.as_ref(), &maps.sizes);
+    }
+}
