@@ -334,9 +334,10 @@ impl PbrShader<'_> {
     }
 
     /// `ng` bent by the normal texture in the derivative tangent frame: `t_ = (∂v/∂y ∂p/∂x −
-    /// ∂v/∂x ∂p/∂y) / (∂u/∂x ∂v/∂y − ∂u/∂y ∂v/∂x)`, `t = normalize(t_ − ng (ng·t_))`,
-    /// `b = ng × t`, `n = normalize(t m.x + b m.y + ng m.z)` with `m = 2 texel − 1`, `m.xy ×=
-    /// scale`; `ng` where the frame is degenerate.
+    /// ∂v/∂x ∂p/∂y) / det` with `det = ∂u/∂x ∂v/∂y − ∂u/∂y ∂v/∂x`, `t = normalize(t_ − ng
+    /// (ng·t_))`, `b = ±ng × t` (negative where the mapping is mirrored: `det < 0` on a front
+    /// face, `det > 0` on a back face), `n = normalize(t m.x + b m.y + ng m.z)` with `m = 2
+    /// texel − 1`, `m.xy ×= scale`; `ng` where the frame is degenerate.
     #[inline(always)]
     fn bent_normal<L: Lanes, F: Fragments<L>>(
         &self,
@@ -374,6 +375,20 @@ impl PbrShader<'_> {
             ng[2] * t[0] - ng[0] * t[2],
             ng[0] * t[1] - ng[1] * t[0],
         ];
+        // Mirrored texture coordinates (the mapping turns the other way on screen than on a
+        // face seen from its front) flip the bitangent.
+        let zero = lanes.splat_f32(0.0);
+        let turned = det.simd_lt(zero);
+        let mirrored = if f.front_facing() {
+            turned
+        } else {
+            turned.not()
+        };
+        let b = [
+            mirrored.select_f32(-b[0], b[0]),
+            mirrored.select_f32(-b[1], b[1]),
+            mirrored.select_f32(-b[2], b[2]),
+        ];
         let texel = f.sample(texture, sampler);
         let two = lanes.splat_f32(2.0);
         let scale = lanes.splat_f32(self.material.normal_scale);
@@ -391,7 +406,6 @@ impl PbrShader<'_> {
             ],
         );
         // normalize3 gives 0 for a degenerate frame (t) or result: keep ng there.
-        let zero = lanes.splat_f32(0.0);
         let usable = (t[0]
             .simd_ne(zero)
             .or(t[1].simd_ne(zero))

@@ -444,11 +444,17 @@ void main() {
         float dv_dx = duv_dx.y;
         float du_dy = duv_dy.x;
         float dv_dy = duv_dy.y;
-        vec3 t_ = (dv_dy * dp_dx - dv_dx * dp_dy) / (du_dx * dv_dy - du_dy * dv_dx);
+        float det = du_dx * dv_dy - du_dy * dv_dx;
+        vec3 t_ = (dv_dy * dp_dx - dv_dx * dp_dy) / det;
         vec3 t = normalize3(t_ - ng * dot3(ng, t_));
         // A degenerate mapping (t zero or not finite) keeps the geometric normal.
         if (t != vec3(0.0)) {
             vec3 b = cross(ng, t);
+            // Mirrored texture coordinates (the mapping turns the other way on screen than on
+            // a face seen from its front) flip the bitangent.
+            if ((det < 0.0) != !gl_FrontFacing) {
+                b = -b;
+            }
             vec3 m = normal_texel.rgb * 2.0 - 1.0;
             m.x = m.x * u_normal_scale;
             m.y = m.y * u_normal_scale;
