@@ -62,7 +62,7 @@ pub struct SceneArgs {
     /// Scene files (.gltf, .glb, .obj), folders of them, or quoted patterns ("scans/*.glb").
     #[arg(value_name = "SCENE")]
     pub scenes: Vec<PathBuf>,
-    /// A built-in scene (cube, teapot, ground, pixel-edges); may be repeated. Built-ins come after the files.
+    /// A built-in scene (cube, teapot, ground, pixel-edges, pbr-spheres, pbr-lights); may be repeated. Built-ins come after the files.
     #[arg(long = "builtin", value_name = "NAME")]
     pub builtins: Vec<String>,
     /// Fail on problems that are otherwise warnings (a texture file missing or undecodable).
@@ -76,9 +76,9 @@ pub struct SceneArgs {
     /// repeated.
     #[arg(long = "allow-read", value_name = "DIR")]
     pub allow_read: Vec<PathBuf>,
-    /// Shading model: `auto` lets the file decide (glTF reference scenes, whose extras carry
-    /// `ambient`, OBJ files and built-ins are drawn with `lambert`; every other glTF file
-    /// with `pbr`, glTF's metallic-roughness model).
+    /// Shading model of scene files: `auto` lets the file decide (glTF reference scenes, whose
+    /// extras carry `ambient`, and OBJ files are drawn with `lambert`; every other glTF file
+    /// with `pbr`, glTF's metallic-roughness model). Built-in scenes keep their own.
     #[arg(long, value_enum, default_value_t = ShadingArg::Auto)]
     pub shading: ShadingArg,
     /// Image-based light of PBR scenes: `studio` (built-in), `none`, or an equirectangular
