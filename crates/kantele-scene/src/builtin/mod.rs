@@ -79,7 +79,9 @@ mod tests {
                 .validate()
                 .unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(loaded.info.camera_from_file);
-            assert_eq!(loaded.scene.clear_color, CLEAR_COLOR);
+            if loaded.scene.shading == kantele_rules::scene::Shading::Lambert {
+                assert_eq!(loaded.scene.clear_color, CLEAR_COLOR);
+            }
             for mesh in &loaded.scene.meshes {
                 assert!(
                     mesh.normals.is_some(),

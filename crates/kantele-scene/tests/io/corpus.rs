@@ -14,7 +14,7 @@ use glam::Vec4;
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::cpu::{CpuBackend, CpuOptions};
 use kantele::scene::{AlphaMode, Scene};
-use kantele_scene::{load_scene, LoadedScene};
+use kantele_scene::{load_scene, load_scene_with, LoadedScene};
 use serde_json::json;
 
 const SIZE: (u32, u32) = (160, 120);
@@ -44,7 +44,20 @@ fn pixel(image: &FrameImage, x: u32, y: u32) -> Vec4 {
     Vec4::from_array(image.color[(y * image.width + x) as usize])
 }
 
+/// Loads with the Lambert rule: the features' pixels below are checked against it (no tone
+/// map, no environment). PBR pictures are checked by the PBR tests; the real files below are
+/// also loaded as a user gets them ([`load_as_chosen`]).
 fn load(path: &Path) -> LoadedScene {
+    let options = kantele_scene::LoadOptions {
+        shading: Some(kantele::scene::Shading::Lambert),
+        ..kantele_scene::LoadOptions::default()
+    };
+    load_scene_with(path, &options)
+        .unwrap_or_else(|e| panic!("{} should load: {e}", path.display()))
+}
+
+/// Loads with the default options: the file's own shading model (PBR for these).
+fn load_as_chosen(path: &Path) -> LoadedScene {
     load_scene(path).unwrap_or_else(|e| panic!("{} should load: {e}", path.display()))
 }
 
@@ -374,9 +387,12 @@ fn realworld_files_render_with_their_properties() {
     ];
     for file in files {
         let path = dir.join(file);
-        let loaded = load(&path);
+        let loaded = load_as_chosen(&path);
+        assert_eq!(loaded.scene.shading, kantele::scene::Shading::Pbr, "{file}");
         let share = covered_share(&loaded.scene);
         assert!(share > 0.01, "{file}: only {share} of the picture covered");
+        let lambert = covered_share(&load(&path).scene);
+        assert_eq!(share, lambert, "{file}: PBR and Lambert cover different pixels");
         // Features this loader handles are never reported as ignored.
         for handled in [
             "KHR_mesh_quantization",

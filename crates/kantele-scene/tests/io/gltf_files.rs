@@ -5,7 +5,7 @@ use std::path::Path;
 
 use crate::common::*;
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use kantele::scene::{AlphaMode, Light, Scene};
+use kantele::scene::{AlphaMode, Light, LightKind, Scene, Shading};
 use kantele::shade::texture::{Filter, MinFilter, Wrap};
 use kantele_scene::{load_scene, LoadedScene};
 use serde_json::json;
@@ -194,13 +194,27 @@ fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
     g.write_gltf_embedded(&path);
     let LoadedScene { scene, info } = load(&path);
 
-    // Defaults: no camera (framing one), headlight, 800 × 600, black, ambient 0.1.
+    // Defaults: no camera (framing one), headlight, 800 × 600, ambient 0.1; without
+    // `ambient` in the extras the file is drawn with PBR: no lights, so the studio, and the
+    // grey background.
     assert!(!info.camera_from_file);
     assert!(info.cameras.is_empty());
     assert_eq!(scene.light, Light::Headlight);
     assert_eq!(scene.resolution, (800, 600));
-    assert_eq!(scene.clear_color, Vec4::new(0.0, 0.0, 0.0, 1.0));
+    assert_eq!(scene.shading, Shading::Pbr);
+    assert!(scene.lights.is_empty());
+    assert!(scene.environment.is_some());
+    assert_eq!(scene.clear_color, Vec4::new(0.2, 0.2, 0.2, 1.0));
     assert_eq!(scene.ambient, 0.1);
+    // Chosen Lambert: no environment, black.
+    let options = kantele_scene::LoadOptions {
+        shading: Some(Shading::Lambert),
+        ..kantele_scene::LoadOptions::default()
+    };
+    let lambert = kantele_scene::load_scene_with(&path, &options).expect("load").scene;
+    assert_eq!(lambert.shading, Shading::Lambert);
+    assert!(lambert.environment.is_none());
+    assert_eq!(lambert.clear_color, Vec4::new(0.0, 0.0, 0.0, 1.0));
     // The framing camera sees the scene's centre straight ahead.
     let (center, _) = scene.bounding_sphere().unwrap();
     let eye_center = scene.camera.view.transform_point3(center);
@@ -312,7 +326,26 @@ fn camera_and_light_come_from_the_first_nodes_in_draw_order() {
     assert_eq!(ortho.camera.ymag, Some(1.0));
     assert_eq!(ortho.camera.aspect_ratio, Some(1.0));
     assert_eq!(ortho.camera.zfar, Some(10.0));
-    assert!(info.warnings.iter().any(|w| w.contains("point and spot")));
+    // PBR (no `ambient` in the extras): every light is drawn, the point light where its
+    // node puts it; no environment, since the file has lights.
+    assert!(!info.warnings.iter().any(|w| w.contains("point and spot")));
+    assert_eq!(scene.lights.len(), 3);
+    assert_eq!(scene.lights[0].kind, LightKind::Point);
+    assert!(scene.lights[0]
+        .position
+        .abs_diff_eq(Vec3::new(1.0, 0.0, 5.0), 1e-6));
+    assert!(scene.environment.is_none());
+    // Lambert draws the first directional light and says the point light is left out.
+    let options = kantele_scene::LoadOptions {
+        shading: Some(Shading::Lambert),
+        ..kantele_scene::LoadOptions::default()
+    };
+    let lambert = kantele_scene::load_scene_with(&path, &options).expect("load");
+    assert!(lambert
+        .info
+        .warnings
+        .iter()
+        .any(|w| w.contains("point and spot")));
     assert!(scene.materials[0].unlit);
     assert_eq!(scene.materials[0].alpha_mode, AlphaMode::Blend);
     assert_eq!(scene.draws[0].node_index, n);
