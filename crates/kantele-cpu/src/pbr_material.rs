@@ -7,7 +7,7 @@
 //! normal — the interpolated world normal, bent by the normal texture in the tangent frame
 //! derived from the screen-space derivatives of the world position and the texture coordinate
 //! (as the glTF sample viewer does for meshes without tangents); then
-//! [`pbr::shade`](kantele_rules::shade::pbr::shade), emission, exposure and the tone map.
+//! [`pbr::shade`], emission, exposure and the tone map.
 //!
 //! One generic routine shades eight fragments at once ([`FragmentLanes`]) and one fragment
 //! ([`Fragment`], every lane holding it), so both follow the same operations.

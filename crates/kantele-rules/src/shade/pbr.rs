@@ -360,7 +360,7 @@ fn punctual<L: Lanes>(
 }
 
 /// The linear colour of a lit surface point, before exposure and tone mapping: every punctual
-/// light by [`punctual`], plus image-based light (diffuse irradiance × `c_diff × (1 − FssEss)`
+/// light by Appendix B (`punctual`), plus image-based light (diffuse irradiance × `c_diff × (1 − FssEss)`
 /// and the pre-filtered specular radiance × `FssEss = F0 A + B`, both × occlusion), where `A`,
 /// `B` are the split-sum terms of the environment's BRDF table.
 #[inline(always)]

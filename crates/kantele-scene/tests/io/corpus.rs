@@ -392,7 +392,10 @@ fn realworld_files_render_with_their_properties() {
         let share = covered_share(&loaded.scene);
         assert!(share > 0.01, "{file}: only {share} of the picture covered");
         let lambert = covered_share(&load(&path).scene);
-        assert_eq!(share, lambert, "{file}: PBR and Lambert cover different pixels");
+        assert_eq!(
+            share, lambert,
+            "{file}: PBR and Lambert cover different pixels"
+        );
         // Features this loader handles are never reported as ignored.
         for handled in [
             "KHR_mesh_quantization",

@@ -211,7 +211,9 @@ fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
         shading: Some(Shading::Lambert),
         ..kantele_scene::LoadOptions::default()
     };
-    let lambert = kantele_scene::load_scene_with(&path, &options).expect("load").scene;
+    let lambert = kantele_scene::load_scene_with(&path, &options)
+        .expect("load")
+        .scene;
     assert_eq!(lambert.shading, Shading::Lambert);
     assert!(lambert.environment.is_none());
     assert_eq!(lambert.clear_color, Vec4::new(0.0, 0.0, 0.0, 1.0));
