@@ -70,6 +70,27 @@ impl VaryingLayout {
     }
 }
 
+/// The fixed-function state a material asks for in `pass` (every built-in material): culling
+/// unless double-sided, and for BLEND alpha blending without depth writes (no blending outside
+/// the colour pass).
+pub fn material_render_state(material: &Material, pass: Pass) -> RenderState {
+    let blend = matches!(material.alpha_mode, AlphaMode::Blend);
+    RenderState {
+        cull: if material.double_sided {
+            CullMode::None
+        } else {
+            CullMode::Back
+        },
+        depth_write: !blend,
+        blend: if blend && pass == Pass::Color {
+            BlendMode::Alpha
+        } else {
+            BlendMode::Replace
+        },
+        ..RenderState::default()
+    }
+}
+
 /// Light and camera shared by every draw of a frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lighting {
@@ -186,21 +207,7 @@ impl<'a> MaterialShader<'a> {
     /// The fixed-function state the material asks for: culling unless double-sided, and for
     /// BLEND alpha blending without depth writes (no blending outside the colour pass).
     pub fn render_state(&self) -> RenderState {
-        let blend = matches!(self.material.alpha_mode, AlphaMode::Blend);
-        RenderState {
-            cull: if self.material.double_sided {
-                CullMode::None
-            } else {
-                CullMode::Back
-            },
-            depth_write: !blend,
-            blend: if blend && self.pass == Pass::Color {
-                BlendMode::Alpha
-            } else {
-                BlendMode::Replace
-            },
-            ..RenderState::default()
-        }
+        material_render_state(self.material, self.pass)
     }
 
     #[inline]

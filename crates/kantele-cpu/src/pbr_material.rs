@@ -14,14 +14,12 @@
 
 use glam::{Mat3, Mat4, Vec2, Vec4};
 
-use crate::material::StandardVertex;
+use crate::material::{material_render_state, StandardVertex};
 use crate::pipeline::{Fragment, FragmentLanes, RenderState, ShadedLanes, Shader};
-use crate::rop::BlendMode;
 use kantele_lanes::{F32x8, Lanes, Mask8, Scalar};
 use kantele_rules::backend::Pass;
 use kantele_rules::camera::normal_matrix;
 use kantele_rules::scene::{AlphaMode, Material};
-use kantele_rules::setup::CullMode;
 use kantele_rules::shade::pbr::{self, normalize3, PbrLighting, Surface};
 use kantele_rules::shade::texture::{Sampler, Texture};
 
@@ -111,23 +109,9 @@ impl<'a> PbrShader<'a> {
         self
     }
 
-    /// Culling unless double-sided; alpha blending without depth writes for BLEND (colour pass).
+    /// The state the material asks for ([`material_render_state`]).
     pub fn render_state(&self) -> RenderState {
-        let blend = matches!(self.material.alpha_mode, AlphaMode::Blend);
-        RenderState {
-            cull: if self.material.double_sided {
-                CullMode::None
-            } else {
-                CullMode::Back
-            },
-            depth_write: !blend,
-            blend: if blend && self.pass == Pass::Color {
-                BlendMode::Alpha
-            } else {
-                BlendMode::Replace
-            },
-            ..RenderState::default()
-        }
+        material_render_state(self.material, self.pass)
     }
 
     fn varying_count(&self) -> usize {

@@ -8,6 +8,7 @@ use super::*;
 use crate::pipeline::{Indices, Renderer, RendererOptions};
 use kantele_lanes::Isa;
 use kantele_rules::scene::{Mesh, Topology};
+use kantele_rules::setup::CullMode;
 use kantele_rules::shade::environment::EnvironmentLight;
 use kantele_rules::shade::pbr::{FrameLight, Tonemap};
 use kantele_rules::shade::texture::{ColorSpace, Filter, MinFilter, Wrap};

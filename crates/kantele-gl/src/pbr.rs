@@ -13,9 +13,12 @@
 
 use glam::Vec3;
 use glow::HasContext;
-use kantele_rules::shade::environment::{EnvironmentLight, BRDF_TABLE_SIZE, SPECULAR_LEVELS};
+use kantele_rules::shade::environment::{
+    EnvironmentLight, BRDF_TABLE_SIZE, SH_Y0, SH_Y1, SH_Y2, SH_Y20, SH_Y22, SPECULAR_LEVELS,
+};
 use kantele_rules::shade::pbr::{
     FrameLight, PbrLighting, Tonemap, DIELECTRIC_F0, MAX_LIGHTS, MIN_PUNCTUAL_ROUGHNESS,
+    PBR_NEUTRAL_DESATURATION, PBR_NEUTRAL_START_COMPRESSION,
 };
 
 use crate::program::{uniforms, Uniforms};
@@ -67,12 +70,6 @@ in vec2 v_texcoord;
 in vec4 v_color;
 in vec3 v_position;
 
-// Spherical harmonics of bands 0-2 (environment.rs: SH_Y0, SH_Y1, SH_Y2, SH_Y20, SH_Y22).
-const float SH_Y0 = 0.2820948;
-const float SH_Y1 = 0.4886025;
-const float SH_Y2 = 1.0925484;
-const float SH_Y20 = 0.31539157;
-const float SH_Y22 = 0.5462742;
 
 uniform vec4 u_base_color_factor;
 uniform bool u_has_texture;
@@ -355,7 +352,6 @@ vec3 shade(vec3 base, float metallic, float roughness, float occlusion, vec3 n, 
 
 // pbr::pbr_neutral (Khronos PBR Neutral).
 vec3 pbr_neutral(vec3 rgb) {
-    const float DESATURATION = 0.15;
     float x = min(rgb.r, min(rgb.g, rgb.b));
     float toe = x - 6.25 * x * x;
     float toe_offset = x < 0.08 ? toe : 0.04;
@@ -500,8 +496,14 @@ pub(crate) fn fragment_source() -> String {
     source += &float("INV_PI", std::f32::consts::FRAC_1_PI);
     source += &float("DIELECTRIC_F0", DIELECTRIC_F0);
     source += &float("MIN_PUNCTUAL_ROUGHNESS", MIN_PUNCTUAL_ROUGHNESS);
-    // pbr_neutral's START_COMPRESSION, 0.8 − 0.04 rounded as f32.
-    source += &float("START_COMPRESSION", 0.8f32 - 0.04f32);
+    source += &float("START_COMPRESSION", PBR_NEUTRAL_START_COMPRESSION);
+    source += &float("DESATURATION", PBR_NEUTRAL_DESATURATION);
+    // Spherical harmonics of bands 0–2.
+    source += &float("SH_Y0", SH_Y0);
+    source += &float("SH_Y1", SH_Y1);
+    source += &float("SH_Y2", SH_Y2);
+    source += &float("SH_Y20", SH_Y20);
+    source += &float("SH_Y22", SH_Y22);
     source += FRAGMENT_BODY;
     source
 }

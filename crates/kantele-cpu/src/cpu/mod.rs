@@ -5,7 +5,7 @@ use std::sync::Arc;
 
 use crate::material::{Lighting, MaterialShader, StandardVertex};
 use crate::pbr_material::{PbrShader, PbrTextures};
-use crate::pipeline::{Indices, RenderState, Renderer, RendererOptions};
+use crate::pipeline::{Indices, RenderState, Renderer, RendererOptions, Shader};
 use crate::raster::Strategy;
 use crate::rop::TargetFormat;
 use kantele_rules::backend::{Backend, FrameImage, FrameView, Pass};
@@ -87,6 +87,40 @@ impl CpuBackend {
     }
 }
 
+/// Clears (the scene's clear colour in the colour pass, 0 in the others) and draws every draw
+/// of `scene` in its draw order, draw `i` with `shaders[i]` under the state `state` gives it
+/// (front faces by the draw's model matrix).
+fn draw_scene<S: Shader<Vertex = StandardVertex>>(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    meshes: &[PreparedMesh],
+    view: &FrameView,
+    shaders: &[S],
+    state: impl Fn(&S) -> RenderState,
+) -> Result<FrameStats, RenderError> {
+    let clear = match view.pass {
+        Pass::Color => scene.clear_color,
+        Pass::Normals | Pass::Ids => glam::Vec4::ZERO,
+    };
+    let mut frame = renderer.begin_frame(Some(clear), Some(1.0));
+    for index in scene.draw_order(&view.view) {
+        let (draw, shader) = (&scene.draws[index], &shaders[index]);
+        let mesh = &meshes[draw.mesh];
+        let state = RenderState {
+            front_face: draw.front_face(),
+            ..state(shader)
+        };
+        frame.draw_primitives(
+            shader,
+            &mesh.vertices,
+            Indices::U32(&mesh.indices),
+            mesh.topology,
+            state,
+        )?;
+    }
+    frame.try_end()
+}
+
 impl CpuBackend {
     /// A frame of a [`Shading::Pbr`] scene (the renderer already sized for `view`).
     fn render_pbr(&mut self, view: &FrameView) -> Result<FrameStats, RenderError> {
@@ -124,27 +158,9 @@ impl CpuBackend {
                 .with_vertex_colors(scene.meshes[draw.mesh].colors.is_some())
             })
             .collect();
-        let clear = match view.pass {
-            Pass::Color => scene.clear_color,
-            Pass::Normals | Pass::Ids => glam::Vec4::ZERO,
-        };
-        let mut frame = self.renderer.begin_frame(Some(clear), Some(1.0));
-        for index in scene.draw_order(&view.view) {
-            let (draw, shader) = (&scene.draws[index], &shaders[index]);
-            let mesh = &meshes[draw.mesh];
-            let state = RenderState {
-                front_face: draw.front_face(),
-                ..shader.render_state()
-            };
-            frame.draw_primitives(
-                shader,
-                &mesh.vertices,
-                Indices::U32(&mesh.indices),
-                mesh.topology,
-                state,
-            )?;
-        }
-        frame.try_end()
+        draw_scene(&mut self.renderer, scene, meshes, view, &shaders, |s| {
+            s.render_state()
+        })
     }
 }
 
@@ -257,27 +273,9 @@ impl Backend for CpuBackend {
                 .with_vertex_colors(scene.meshes[draw.mesh].colors.is_some())
             })
             .collect();
-        let clear = match view.pass {
-            Pass::Color => scene.clear_color,
-            Pass::Normals | Pass::Ids => glam::Vec4::ZERO,
-        };
-        let mut frame = self.renderer.begin_frame(Some(clear), Some(1.0));
-        for index in scene.draw_order(&view.view) {
-            let (draw, shader) = (&scene.draws[index], &shaders[index]);
-            let mesh = &meshes[draw.mesh];
-            let state = RenderState {
-                front_face: draw.front_face(),
-                ..shader.render_state()
-            };
-            frame.draw_primitives(
-                shader,
-                &mesh.vertices,
-                Indices::U32(&mesh.indices),
-                mesh.topology,
-                state,
-            )?;
-        }
-        frame.try_end()
+        draw_scene(&mut self.renderer, scene, meshes, view, &shaders, |s| {
+            s.render_state()
+        })
     }
 
     fn set_samples(&mut self, samples: SampleCount) -> Result<(), RenderError> {

@@ -135,10 +135,10 @@ impl EnvironmentLight {
         (-self.rotation).sin_cos()
     }
 
-    /// World direction `d` turned into the environment's frame.
+    /// World direction `d` turned into the environment's frame by `(sin, cos)` of
+    /// [`EnvironmentLight::lookup_rotation`].
     #[inline]
-    fn rotate(&self, d: Vec3) -> Vec3 {
-        let (sin, cos) = self.lookup_rotation();
+    fn rotate((sin, cos): (f32, f32), d: Vec3) -> Vec3 {
         Vec3::new(cos * d.x + sin * d.z, d.y, -sin * d.x + cos * d.z)
     }
 
@@ -184,10 +184,11 @@ impl EnvironmentLight {
     ) -> [L::F32; 3] {
         let (x, y, z) = (r[0].to_array(), r[1].to_array(), r[2].to_array());
         let rough = roughness.to_array();
+        let rotation = self.lookup_rotation();
         let mut out = [[0.0f32; 8]; 3];
         for k in 0..8 {
             let d = Vec3::new(x[k], y[k], z[k]);
-            let c = self.specular(d, rough[k]);
+            let c = self.specular_rotated(rotation, d, rough[k]);
             out[0][k] = c.x;
             out[1][k] = c.y;
             out[2][k] = c.z;
@@ -201,7 +202,12 @@ impl EnvironmentLight {
 
     /// [`EnvironmentLight::specular_lanes`] for one direction.
     pub fn specular(&self, r: Vec3, roughness: f32) -> Vec3 {
-        let d = self.rotate(r).normalize_or_zero();
+        self.specular_rotated(self.lookup_rotation(), r, roughness)
+    }
+
+    /// [`EnvironmentLight::specular`] with the rotation's `(sin, cos)` computed by the caller.
+    fn specular_rotated(&self, rotation: (f32, f32), r: Vec3, roughness: f32) -> Vec3 {
+        let d = Self::rotate(rotation, r).normalize_or_zero();
         let last = (SPECULAR_LEVELS - 1) as f32;
         let lod = if roughness.is_finite() {
             (roughness * last).clamp(0.0, last)
@@ -237,13 +243,17 @@ impl EnvironmentLight {
     }
 }
 
-// Real spherical harmonics of bands 0–2, and the cosine lobe's band factors (π, 2π/3, π/4),
-// divided by π so the sum gives irradiance ÷ π.
-const SH_Y0: f32 = 0.282_094_8;
-const SH_Y1: f32 = 0.488_602_5;
-const SH_Y2: f32 = 1.092_548_4;
-const SH_Y20: f32 = 0.315_391_57;
-const SH_Y22: f32 = 0.546_274_2;
+/// Real spherical harmonic of band 0: `Y0 = 1 / (2 √π)`.
+pub const SH_Y0: f32 = 0.282_094_8;
+/// Band 1: `Y = SH_Y1 × (y, z, x)`.
+pub const SH_Y1: f32 = 0.488_602_5;
+/// Band 2: `SH_Y2 × (xy, yz, xz)`.
+pub const SH_Y2: f32 = 1.092_548_4;
+/// Band 2: `SH_Y20 × (3z² − 1)`.
+pub const SH_Y20: f32 = 0.315_391_57;
+/// Band 2: `SH_Y22 × (x² − y²)`.
+pub const SH_Y22: f32 = 0.546_274_2;
+// The cosine lobe's band factors (π, 2π/3, π/4), divided by π so the sum gives irradiance ÷ π.
 const SH_BAND: [f32; 3] = [1.0, 2.0 / 3.0, 0.25];
 
 fn sh_basis(d: Vec3) -> [f32; 9] {

@@ -453,11 +453,16 @@ pub fn tonemap<L: Lanes>(
     }
 }
 
+/// Khronos PBR Neutral: peak values from here on are compressed towards white.
+pub const PBR_NEUTRAL_START_COMPRESSION: f32 = 0.8 - 0.04;
+/// Khronos PBR Neutral: how far compressed colours move towards white.
+pub const PBR_NEUTRAL_DESATURATION: f32 = 0.15;
+
 /// Khronos PBR Neutral (the reference GLSL, operation for operation).
 #[inline(always)]
 fn pbr_neutral<L: Lanes>(lanes: L, rgb: [L::F32; 3]) -> [L::F32; 3] {
-    const START_COMPRESSION: f32 = 0.8 - 0.04;
-    const DESATURATION: f32 = 0.15;
+    const START_COMPRESSION: f32 = PBR_NEUTRAL_START_COMPRESSION;
+    const DESATURATION: f32 = PBR_NEUTRAL_DESATURATION;
     let one = lanes.splat_f32(1.0);
     let x = rgb[0].min(rgb[1].min(rgb[2]));
     let small = x - lanes.splat_f32(6.25) * x * x;

@@ -87,21 +87,6 @@ impl TextureSlot {
     }
 }
 
-/// The name of the texture whose coordinates a material's meshes carry: the first one bound.
-fn refs_first_name(material: &Material) -> &'static str {
-    if material.base_color_texture.is_some() {
-        TextureSlot::BaseColor.name()
-    } else if material.emissive_texture.is_some() {
-        TextureSlot::Emissive.name()
-    } else if material.metallic_roughness_texture.is_some() {
-        TextureSlot::MetallicRoughness.name()
-    } else if material.normal_texture.is_some() {
-        TextureSlot::Normal.name()
-    } else {
-        "first"
-    }
-}
-
 impl Loader<'_> {
     /// Converts a material; also records which texture coordinates its textures read
     /// (`self.material_uv`), which the loader bakes into the meshes that use it.
@@ -165,20 +150,20 @@ impl Loader<'_> {
         };
         // The meshes carry one set of texture coordinates per material: the first texture's
         // (the base colour's when it has one). A texture reading other coordinates is left out.
-        let mut uv = None;
+        let mut first: Option<(UvMap, TextureSlot)> = None;
         for (slot, texture, color_space, map) in refs {
             if material.unlit() && slot != TextureSlot::BaseColor {
                 // KHR_materials_unlit: every property but the base colour is a fallback for
                 // viewers without the extension.
                 continue;
             }
-            match uv {
-                None => uv = Some(map),
-                Some(first) if first != map => {
+            match first {
+                None => first = Some((map, slot)),
+                Some((first_map, first_slot)) if first_map != map => {
                     self.info.warn(format!(
                         "material '{name}': the {} texture reads other texture coordinates than the {} texture; it is left out",
                         slot.name(),
-                        refs_first_name(&out),
+                        first_slot.name(),
                     ));
                     if slot == TextureSlot::Emissive {
                         out.emissive = Vec3::ZERO;
@@ -196,7 +181,7 @@ impl Loader<'_> {
                 TextureSlot::Occlusion => out.occlusion_texture = binding,
             }
         }
-        self.material_uv.push(uv);
+        self.material_uv.push(first.map(|(map, _)| map));
         out.alpha_mode = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => AlphaMode::Mask {
