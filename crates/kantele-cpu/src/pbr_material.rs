@@ -15,7 +15,9 @@
 use glam::{Mat3, Mat4, Vec2, Vec4};
 
 use crate::material::{material_render_state, StandardVertex};
-use crate::pipeline::{Fragment, FragmentLanes, RenderState, ShadedLanes, Shader};
+use crate::pipeline::{
+    Fragment, FragmentLanes, LaneProgram, LaneProgramJob, RenderState, ShadedLanes, Shader,
+};
 use kantele_lanes::{F32x8, Lanes, Mask8, Scalar};
 use kantele_rules::backend::Pass;
 use kantele_rules::camera::normal_matrix;
@@ -53,7 +55,7 @@ pub struct PbrTextures<'a> {
     pub occlusion: BoundTexture<'a>,
 }
 
-impl PbrTextures<'_> {
+impl<'a> PbrTextures<'a> {
     fn any(&self) -> bool {
         self.base_color.is_some()
             || self.emissive.is_some()
@@ -61,6 +63,56 @@ impl PbrTextures<'_> {
             || self.normal.is_some()
             || self.occlusion.is_some()
     }
+
+    /// The textures a draw of `pass` reads, with the slot of [`Texels`] each fills: all of
+    /// them for colour; the base colour (for its alpha, where the material tests it) and the
+    /// normal texture for normals; the base colour for ids, where alpha is tested.
+    fn reads(&self, pass: Pass, alpha_tested: bool) -> TextureReads<'a> {
+        let mut reads = TextureReads {
+            reads: [None; SLOTS],
+            count: 0,
+        };
+        let slots = [
+            (
+                BASE_COLOR,
+                self.base_color,
+                pass == Pass::Color || alpha_tested,
+            ),
+            (EMISSIVE, self.emissive, pass == Pass::Color),
+            (
+                METALLIC_ROUGHNESS,
+                self.metallic_roughness,
+                pass == Pass::Color,
+            ),
+            (NORMAL, self.normal, pass != Pass::Ids),
+            (OCCLUSION, self.occlusion, pass == Pass::Color),
+        ];
+        for (slot, bound, wanted) in slots {
+            if let (Some((texture, sampler)), true) = (bound, wanted) {
+                reads.reads[reads.count] = Some((slot, texture, sampler));
+                reads.count += 1;
+            }
+        }
+        reads
+    }
+}
+
+/// Slots of [`Texels`].
+const BASE_COLOR: usize = 0;
+const EMISSIVE: usize = 1;
+const METALLIC_ROUGHNESS: usize = 2;
+const NORMAL: usize = 3;
+const OCCLUSION: usize = 4;
+const SLOTS: usize = 5;
+
+/// The texels of a fragment's textures, by slot (1 where a texture is not read).
+type Texels<L> = [[<L as Lanes>::F32; 4]; SLOTS];
+
+/// The textures one draw reads, in slot order: the first `count` entries.
+#[derive(Clone, Copy)]
+struct TextureReads<'a> {
+    reads: [Option<(usize, &'a Texture, Sampler)>; SLOTS],
+    count: usize,
 }
 
 /// The shader of one draw of a PBR scene.
@@ -71,6 +123,8 @@ pub struct PbrShader<'a> {
     lighting: &'a PbrLighting,
     material: &'a Material,
     textures: PbrTextures<'a>,
+    /// What the fragment program samples ([`PbrTextures::reads`]).
+    reads: TextureReads<'a>,
     pass: Pass,
     /// `(instance id, draw id)` for the id pass.
     ids: (f32, f32),
@@ -90,6 +144,7 @@ impl<'a> PbrShader<'a> {
         pass: Pass,
         ids: (u32, u32),
     ) -> Self {
+        let alpha_tested = !matches!(material.alpha_mode, AlphaMode::Opaque);
         Self {
             model,
             model_view_projection: view_projection * model,
@@ -97,6 +152,7 @@ impl<'a> PbrShader<'a> {
             lighting,
             material,
             textures,
+            reads: textures.reads(pass, alpha_tested),
             pass,
             ids: (ids.0 as f32, ids.1 as f32),
             vertex_colors: true,
@@ -207,6 +263,20 @@ impl Fragments<Scalar> for Fragment<'_> {
 }
 
 impl PbrShader<'_> {
+    /// The texels of every texture the draw reads ([`PbrTextures::reads`]), from one call site
+    /// of the sampler in a loop: the sampler is the largest part of the program, and each of
+    /// its call sites is compiled into every kernel.
+    #[inline(always)]
+    fn sample_textures<L: Lanes, F: Fragments<L>>(&self, f: &F) -> Texels<L> {
+        let one = f.lanes().splat_f32(1.0);
+        let mut texels = [[one; 4]; SLOTS];
+        let reads = &self.reads;
+        for (slot, texture, sampler) in reads.reads[..reads.count].iter().flatten() {
+            texels[*slot] = f.sample(texture, sampler);
+        }
+        texels
+    }
+
     /// The shading routine (see the module docs): colour and the lanes kept.
     #[inline(always)]
     fn shade<L: Lanes, F: Fragments<L>>(&self, f: &F) -> ([L::F32; 4], L::Mask) {
@@ -219,6 +289,7 @@ impl PbrShader<'_> {
         if self.pass == Pass::Ids && !needs_alpha {
             return (self.ids_lanes(lanes, f.primitive_id()), all);
         }
+        let texels = self.sample_textures(f);
         // --- base colour and alpha ---
         let factor = m.base_color_factor.to_array();
         let mut base = factor.map(|c| lanes.splat_f32(c));
@@ -227,10 +298,9 @@ impl PbrShader<'_> {
                 *b = *b * f.varying(at::COLOR + c);
             }
         }
-        if let Some((texture, sampler)) = self.textures.base_color {
-            let texel = f.sample(texture, &sampler);
+        if self.textures.base_color.is_some() {
             for c in 0..4 {
-                base[c] = base[c] * texel[c];
+                base[c] = base[c] * texels[BASE_COLOR][c];
             }
         }
         let (alpha, keep) = match m.alpha_mode {
@@ -241,17 +311,16 @@ impl PbrShader<'_> {
         if self.pass == Pass::Ids {
             return (self.ids_lanes(lanes, f.primitive_id()), keep);
         }
-        let normal = self.normal(f);
+        let normal = self.normal(f, &texels);
         if self.pass == Pass::Normals {
             return ([normal[0], normal[1], normal[2], one], keep);
         }
         // --- emission ---
         let e = m.emissive.to_array();
         let mut emissive = e.map(|c| lanes.splat_f32(c));
-        if let Some((texture, sampler)) = self.textures.emissive {
-            let texel = f.sample(texture, &sampler);
+        if self.textures.emissive.is_some() {
             for c in 0..3 {
-                emissive[c] = emissive[c] * texel[c];
+                emissive[c] = emissive[c] * texels[EMISSIVE][c];
             }
         }
         let lit = if m.unlit {
@@ -259,15 +328,15 @@ impl PbrShader<'_> {
         } else {
             let mut metallic = lanes.splat_f32(m.metallic);
             let mut roughness = lanes.splat_f32(m.roughness);
-            if let Some((texture, sampler)) = self.textures.metallic_roughness {
-                let texel = f.sample(texture, &sampler);
+            if self.textures.metallic_roughness.is_some() {
+                let texel = texels[METALLIC_ROUGHNESS];
                 metallic = metallic * texel[2];
                 roughness = roughness * texel[1];
             }
             let clamp = |x: L::F32| x.max(zero).min(one);
             let mut occlusion = one;
-            if let Some((texture, sampler)) = self.textures.occlusion {
-                let texel = f.sample(texture, &sampler);
+            if self.textures.occlusion.is_some() {
+                let texel = texels[OCCLUSION];
                 occlusion = one + lanes.splat_f32(m.occlusion_strength) * (texel[0] - one);
             }
             let surface = Surface {
@@ -296,7 +365,7 @@ impl PbrShader<'_> {
     /// The shading normal: the interpolated normal, bent by the normal texture (see the module
     /// docs), flipped on back faces of double-sided materials.
     #[inline(always)]
-    fn normal<L: Lanes, F: Fragments<L>>(&self, f: &F) -> [L::F32; 3] {
+    fn normal<L: Lanes, F: Fragments<L>>(&self, f: &F, texels: &Texels<L>) -> [L::F32; 3] {
         let lanes = f.lanes();
         let ng = normalize3(
             lanes,
@@ -307,8 +376,8 @@ impl PbrShader<'_> {
             ],
         );
         let mut n = ng;
-        if let Some((texture, sampler)) = self.textures.normal {
-            n = self.bent_normal(f, ng, texture, &sampler);
+        if self.textures.normal.is_some() {
+            n = self.bent_normal(f, ng, texels[NORMAL]);
         }
         if self.material.double_sided && !f.front_facing() {
             [-n[0], -n[1], -n[2]]
@@ -317,7 +386,7 @@ impl PbrShader<'_> {
         }
     }
 
-    /// `ng` bent by the normal texture in the derivative tangent frame: `t_ = (∂v/∂y ∂p/∂x −
+    /// `ng` bent by the normal texture's `texel` in the derivative tangent frame: `t_ = (∂v/∂y ∂p/∂x −
     /// ∂v/∂x ∂p/∂y) / det` with `det = ∂u/∂x ∂v/∂y − ∂u/∂y ∂v/∂x`, `t = normalize(t_ − ng
     /// (ng·t_))`, `b = ±ng × t` (negative where the mapping is mirrored: `det < 0` on a front
     /// face, `det > 0` on a back face), `n = normalize(t m.x + b m.y + ng m.z)` with `m = 2
@@ -327,8 +396,7 @@ impl PbrShader<'_> {
         &self,
         f: &F,
         ng: [L::F32; 3],
-        texture: &Texture,
-        sampler: &Sampler,
+        texel: [L::F32; 4],
     ) -> [L::F32; 3] {
         let lanes = f.lanes();
         let one = lanes.splat_f32(1.0);
@@ -373,7 +441,6 @@ impl PbrShader<'_> {
             mirrored.select_f32(-b[1], b[1]),
             mirrored.select_f32(-b[2], b[2]),
         ];
-        let texel = f.sample(texture, sampler);
         let two = lanes.splat_f32(2.0);
         let scale = lanes.splat_f32(self.material.normal_scale);
         let m = [
@@ -457,6 +524,28 @@ impl Shader for PbrShader<'_> {
     #[inline(always)]
     fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
         let (color, keep) = self.shade(fragments);
+        ShadedLanes { color, keep }
+    }
+
+    /// [`PbrProgram`]: `fragment_lanes` with no kernels of its own for constant triangles.
+    #[inline(always)]
+    fn with_lane_program<J: LaneProgramJob>(&self, job: J) -> J::Output {
+        job.run(&PbrProgram(self))
+    }
+}
+
+/// The PBR shader's [`Shader::fragment_lanes`] as the draw's lane program, opting out of the
+/// kernels for constant triangles ([`LaneProgram::CONSTANT_KERNELS`]): a PBR triangle reads
+/// its world position, which is never the same at three vertices, and the program is the
+/// largest the renderer compiles.
+struct PbrProgram<'s, 'a>(&'s PbrShader<'a>);
+
+impl LaneProgram for PbrProgram<'_, '_> {
+    const CONSTANT_KERNELS: bool = false;
+
+    #[inline(always)]
+    fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
+        let (color, keep) = self.0.shade(fragments);
         ShadedLanes { color, keep }
     }
 }

@@ -13,7 +13,7 @@ use std::f32::consts::PI;
 use std::sync::{Arc, OnceLock};
 
 use glam::{Vec2, Vec3};
-use kantele_lanes::{F32x8, Lanes};
+use kantele_lanes::{F32x8, I32x8, Lanes, Mask8, Scalar};
 
 use crate::error::RenderError;
 
@@ -104,6 +104,9 @@ pub struct Environment {
     pub levels: Vec<OctahedralLevel>,
     /// The source's size `(width, height)`, for reports.
     pub source_size: (u32, u32),
+    /// The texels of every level, one after another (level `k` from `LEVEL_OFFSETS[k]`), as
+    /// `f32` bits with RGB interleaved: what the lane lookups gather from.
+    texel_bits: Vec<u32>,
 }
 
 /// An environment as a frame uses it: the prepared maps, their intensity and rotation.
@@ -133,13 +136,6 @@ impl EnvironmentLight {
     #[inline]
     pub fn lookup_rotation(&self) -> (f32, f32) {
         (-self.rotation).sin_cos()
-    }
-
-    /// World direction `d` turned into the environment's frame by `(sin, cos)` of
-    /// [`EnvironmentLight::lookup_rotation`].
-    #[inline]
-    fn rotate((sin, cos): (f32, f32), d: Vec3) -> Vec3 {
-        Vec3::new(cos * d.x + sin * d.z, d.y, -sin * d.x + cos * d.z)
     }
 
     /// Irradiance ÷ π at unit normals `n`, per lane (intensity not applied).
@@ -174,7 +170,8 @@ impl EnvironmentLight {
 
     /// Pre-filtered specular radiance along `r` (need not be unit) at `roughness`, per lane:
     /// bilinear in the two levels around `roughness × (SPECULAR_LEVELS − 1)`, linear between
-    /// them (intensity not applied).
+    /// them (intensity not applied). Every lane reads its own levels, by gathers from the
+    /// environment's texels ([`Environment::texel_bits`]).
     #[inline(always)]
     pub fn specular_lanes<L: Lanes>(
         &self,
@@ -182,50 +179,40 @@ impl EnvironmentLight {
         r: &[L::F32; 3],
         roughness: L::F32,
     ) -> [L::F32; 3] {
-        let (x, y, z) = (r[0].to_array(), r[1].to_array(), r[2].to_array());
-        let rough = roughness.to_array();
-        let rotation = self.lookup_rotation();
-        let mut out = [[0.0f32; 8]; 3];
-        for k in 0..8 {
-            let d = Vec3::new(x[k], y[k], z[k]);
-            let c = self.specular_rotated(rotation, d, rough[k]);
-            out[0][k] = c.x;
-            out[1][k] = c.y;
-            out[2][k] = c.z;
-        }
+        let (sin, cos) = self.lookup_rotation();
+        let (s, c) = (lanes.splat_f32(sin), lanes.splat_f32(cos));
+        let rotated = [c * r[0] + s * r[2], r[1], c * r[2] - s * r[0]];
+        let d = normalize_or_zero_lanes(lanes, rotated);
+        let uv = octahedral_encode_lanes(lanes, &d);
+        let last = lanes.splat_f32((SPECULAR_LEVELS - 1) as f32);
+        let zero = lanes.splat_f32(0.0);
+        let finite = roughness.abs().simd_lt(lanes.splat_f32(f32::INFINITY));
+        let lod = finite.select_f32((roughness * last).max(zero).min(last), last);
+        let level = lod.floor();
+        let t = lod - level;
+        let lo_level = level.to_i32_trunc();
+        let hi_level =
+            (lo_level + lanes.splat_i32(1)).min(lanes.splat_i32(SPECULAR_LEVELS as i32 - 1));
+        let table = &self.environment.texel_bits;
+        let lo = sample_level_lanes(lanes, table, lo_level, &uv);
+        let hi = sample_level_lanes(lanes, table, hi_level, &uv);
+        let exact = t.simd_eq(zero);
         [
-            lanes.f32_from_array(out[0]),
-            lanes.f32_from_array(out[1]),
-            lanes.f32_from_array(out[2]),
+            exact.select_f32(lo[0], lo[0] + (hi[0] - lo[0]) * t),
+            exact.select_f32(lo[1], lo[1] + (hi[1] - lo[1]) * t),
+            exact.select_f32(lo[2], lo[2] + (hi[2] - lo[2]) * t),
         ]
     }
 
     /// [`EnvironmentLight::specular_lanes`] for one direction.
     pub fn specular(&self, r: Vec3, roughness: f32) -> Vec3 {
-        self.specular_rotated(self.lookup_rotation(), r, roughness)
+        let lanes = Scalar;
+        let r = r.to_array().map(|c| lanes.splat_f32(c));
+        let out = self.specular_lanes(lanes, &r, lanes.splat_f32(roughness));
+        Vec3::new(out[0].extract(0), out[1].extract(0), out[2].extract(0))
     }
 
-    /// [`EnvironmentLight::specular`] with the rotation's `(sin, cos)` computed by the caller.
-    fn specular_rotated(&self, rotation: (f32, f32), r: Vec3, roughness: f32) -> Vec3 {
-        let d = Self::rotate(rotation, r).normalize_or_zero();
-        let last = (SPECULAR_LEVELS - 1) as f32;
-        let lod = if roughness.is_finite() {
-            (roughness * last).clamp(0.0, last)
-        } else {
-            last
-        };
-        let level = lod.floor();
-        let t = lod - level;
-        let levels = &self.environment.levels;
-        let lo = levels[level as usize].sample(d);
-        if t == 0.0 {
-            return lo;
-        }
-        let hi = levels[(level as usize + 1).min(SPECULAR_LEVELS - 1)].sample(d);
-        lo + (hi - lo) * t
-    }
-
-    /// The split-sum terms `(A, B)` at `NdotV` and `roughness`, per lane ([`brdf_ab`]).
+    /// The split-sum terms `(A, B)` at `NdotV` and `roughness`, per lane ([`brdf_ab_lanes`]).
     #[inline(always)]
     pub fn brdf_lanes<L: Lanes>(
         &self,
@@ -233,15 +220,131 @@ impl EnvironmentLight {
         n_dot_v: L::F32,
         roughness: L::F32,
     ) -> [L::F32; 2] {
-        let (v, r) = (n_dot_v.to_array(), roughness.to_array());
-        let mut a = [0.0f32; 8];
-        let mut b = [0.0f32; 8];
-        for k in 0..8 {
-            [a[k], b[k]] = brdf_ab(v[k], r[k]);
-        }
-        [lanes.f32_from_array(a), lanes.f32_from_array(b)]
+        brdf_ab_lanes(lanes, n_dot_v, roughness)
     }
 }
+
+/// The split-sum terms `(A, B)` at `NdotV` and `roughness`, per lane: read bilinearly from
+/// [`brdf_table`], clamped to its cell centres (a non-finite coordinate reads as 1).
+#[inline(always)]
+pub fn brdf_ab_lanes<L: Lanes>(lanes: L, n_dot_v: L::F32, roughness: L::F32) -> [L::F32; 2] {
+    let n = BRDF_TABLE_SIZE as f32;
+    let (zero, one) = (lanes.splat_f32(0.0), lanes.splat_f32(1.0));
+    let coordinate = |v: L::F32| {
+        let v = v
+            .abs()
+            .simd_lt(lanes.splat_f32(f32::INFINITY))
+            .select_f32(v, one);
+        (v * lanes.splat_f32(n) - lanes.splat_f32(0.5))
+            .max(zero)
+            .min(lanes.splat_f32(n - 1.0))
+    };
+    let (x, y) = (coordinate(n_dot_v), coordinate(roughness));
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (x0, y0) = (x0.to_i32_trunc(), y0.to_i32_trunc());
+    let last = lanes.splat_i32(BRDF_TABLE_SIZE as i32 - 1);
+    let step = lanes.splat_i32(1);
+    let (x1, y1) = ((x0 + step).min(last), (y0 + step).min(last));
+    let size = lanes.splat_i32(BRDF_TABLE_SIZE as i32);
+    let table = brdf_table_bits();
+    // Cell (x, y) holds A at 2 (y size + x) and B after it.
+    let cell = |x: L::I32, y: L::I32| (y * size + x).shl::<1>();
+    let corners = [cell(x0, y0), cell(x1, y0), cell(x0, y1), cell(x1, y1)];
+    let mut out = [zero; 2];
+    for (c, o) in out.iter_mut().enumerate() {
+        let channel = lanes.splat_i32(c as i32);
+        let t = corners.map(|i| L::F32::from_bits((i + channel).gather_u32(table)));
+        let top = t[0] + (t[1] - t[0]) * fx;
+        let bottom = t[2] + (t[3] - t[2]) * fx;
+        *o = top + (bottom - top) * fy;
+    }
+    out
+}
+
+/// `v / |v|` per lane, or 0 where that is not finite or not positive (glam's
+/// `normalize_or_zero`, operation for operation).
+#[inline(always)]
+fn normalize_or_zero_lanes<L: Lanes>(lanes: L, v: [L::F32; 3]) -> [L::F32; 3] {
+    let length = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+    let rcp = lanes.splat_f32(1.0) / length;
+    let zero = lanes.splat_f32(0.0);
+    let usable = rcp
+        .abs()
+        .simd_lt(lanes.splat_f32(f32::INFINITY))
+        .and(rcp.simd_gt(zero));
+    v.map(|c| usable.select_f32(c * rcp, zero))
+}
+
+/// [`octahedral_encode`] per lane, operation for operation.
+#[inline(always)]
+fn octahedral_encode_lanes<L: Lanes>(lanes: L, d: &[L::F32; 3]) -> [L::F32; 2] {
+    let (zero, one, half) = (
+        lanes.splat_f32(0.0),
+        lanes.splat_f32(1.0),
+        lanes.splat_f32(0.5),
+    );
+    let sum = d[0].abs() + d[1].abs() + d[2].abs();
+    let positive = sum.simd_gt(zero);
+    let px = positive.select_f32(d[0] / sum, zero);
+    let py = positive.select_f32(d[1] / sum, zero);
+    let sign = |v: L::F32| v.simd_ge(zero).select_f32(one, -one);
+    let below = d[2].simd_lt(zero);
+    let fx = below.select_f32((one - py.abs()) * sign(px), px);
+    let fy = below.select_f32((one - px.abs()) * sign(py), py);
+    [fx * half + half, fy * half + half]
+}
+
+/// [`OctahedralLevel::sample`] per lane, each lane in its own `level`, from `table`
+/// ([`Environment::texel_bits`]) at octahedral coordinates `uv`.
+#[inline(always)]
+fn sample_level_lanes<L: Lanes>(
+    lanes: L,
+    table: &[u32],
+    level: L::I32,
+    uv: &[L::F32; 2],
+) -> [L::F32; 3] {
+    let zero = lanes.splat_f32(0.0);
+    let size_i = level.gather_u32(&LEVEL_SIZES);
+    let size = size_i.to_f32();
+    let stride = size_i + lanes.splat_i32(2);
+    let first = level.gather_u32(&LEVEL_OFFSETS);
+    let half = lanes.splat_f32(0.5);
+    let limit = size + lanes.splat_f32(1.0);
+    // Texel centre i sits at (i + 0.5) / size; the border shifts indices by one.
+    let x = (uv[0] * size + half).max(zero).min(limit);
+    let y = (uv[1] * size + half).max(zero).min(limit);
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let (x0, y0) = (x0.to_i32_trunc(), y0.to_i32_trunc());
+    let edge = stride - lanes.splat_i32(1);
+    let step = lanes.splat_i32(1);
+    let (x1, y1) = ((x0 + step).min(edge), (y0 + step).min(edge));
+    let three = lanes.splat_i32(3);
+    let texel = |x: L::I32, y: L::I32| (first + y * stride + x) * three;
+    let corners = [texel(x0, y0), texel(x1, y0), texel(x0, y1), texel(x1, y1)];
+    let mut out = [zero; 3];
+    for (c, o) in out.iter_mut().enumerate() {
+        let channel = lanes.splat_i32(c as i32);
+        let t = corners.map(|i| L::F32::from_bits((i + channel).gather_u32(table)));
+        let top = t[0] + (t[1] - t[0]) * fx;
+        let bottom = t[2] + (t[3] - t[2]) * fx;
+        *o = top + (bottom - top) * fy;
+    }
+    out
+}
+
+/// Where each specular level's texels start in [`Environment::texel_bits`], in texels.
+const LEVEL_OFFSETS: [u32; SPECULAR_LEVELS] = {
+    let mut offsets = [0; SPECULAR_LEVELS];
+    let mut k = 1;
+    while k < SPECULAR_LEVELS {
+        let stride = LEVEL_SIZES[k - 1] + 2;
+        offsets[k] = offsets[k - 1] + stride * stride;
+        k += 1;
+    }
+    offsets
+};
 
 /// Real spherical harmonic of band 0: `Y0 = 1 / (2 √π)`.
 pub const SH_Y0: f32 = 0.282_094_8;
@@ -291,28 +394,23 @@ pub fn brdf_table() -> &'static [[f32; 2]] {
     })
 }
 
-/// `(A, B)` read bilinearly from [`brdf_table`] (clamped to its cell centres).
+/// [`brdf_table`] as `f32` bits, `(A, B)` interleaved, for gathers.
+fn brdf_table_bits() -> &'static [u32] {
+    static BITS: OnceLock<Vec<u32>> = OnceLock::new();
+    BITS.get_or_init(|| {
+        brdf_table()
+            .iter()
+            .flat_map(|ab| ab.map(f32::to_bits))
+            .collect()
+    })
+}
+
+/// `(A, B)` read bilinearly from [`brdf_table`] (clamped to its cell centres):
+/// [`brdf_ab_lanes`] for one point.
 pub fn brdf_ab(n_dot_v: f32, roughness: f32) -> [f32; 2] {
-    let n = BRDF_TABLE_SIZE as f32;
-    let coordinate = |v: f32| {
-        let v = if v.is_finite() { v } else { 1.0 };
-        (v * n - 0.5).clamp(0.0, n - 1.0)
-    };
-    let (x, y) = (coordinate(n_dot_v), coordinate(roughness));
-    let (x0, y0) = (x.floor(), y.floor());
-    let (fx, fy) = (x - x0, y - y0);
-    let size = BRDF_TABLE_SIZE;
-    let (x0, y0) = (x0 as usize, y0 as usize);
-    let (x1, y1) = ((x0 + 1).min(size - 1), (y0 + 1).min(size - 1));
-    let table = brdf_table();
-    let t = |x: usize, y: usize| table[y * size + x];
-    let mut out = [0.0; 2];
-    for (c, o) in out.iter_mut().enumerate() {
-        let top = t(x0, y0)[c] + (t(x1, y0)[c] - t(x0, y0)[c]) * fx;
-        let bottom = t(x0, y1)[c] + (t(x1, y1)[c] - t(x0, y1)[c]) * fx;
-        *o = top + (bottom - top) * fy;
-    }
-    out
+    let lanes = Scalar;
+    let [a, b] = brdf_ab_lanes(lanes, lanes.splat_f32(n_dot_v), lanes.splat_f32(roughness));
+    [a.extract(0), b.extract(0)]
 }
 
 /// The `i`-th of `n` points of the Hammersley set.
@@ -421,10 +519,16 @@ impl Environment {
             let roughness = k as f32 / (SPECULAR_LEVELS - 1) as f32;
             levels.push(prefilter(&chain, size, roughness));
         }
+        let texel_bits = levels
+            .iter()
+            .flat_map(|level| level.texels.iter())
+            .flat_map(|texel| texel.map(f32::to_bits))
+            .collect();
         Ok(Self {
             irradiance_sh,
             levels,
             source_size: (width, height),
+            texel_bits,
         })
     }
 }

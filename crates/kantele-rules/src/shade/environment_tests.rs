@@ -1,6 +1,7 @@
 //! Tests of the environment's preparation and lookups.
 
 use glam::{Vec2, Vec3};
+use kantele_lanes::{dispatch, Isa, LaneKernel};
 
 use super::*;
 
@@ -118,4 +119,140 @@ fn bad_sources_are_refused() {
     let nan = vec![Vec3::NAN; 8];
     let env = Environment::from_equirect(4, 2, &nan).expect("NaN texels count as 0");
     assert!(env.irradiance_sh.iter().all(|c| *c == Vec3::ZERO));
+}
+
+/// Directions spread over the sphere (a Fibonacci spiral), some of them not unit.
+fn spiral(i: usize, n: usize) -> Vec3 {
+    let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+    let phi = i as f32 * 2.399_963;
+    let r = (1.0 - z * z).sqrt();
+    Vec3::new(r * phi.cos(), r * phi.sin(), z) * (0.5 + (i % 3) as f32)
+}
+
+/// The specular lookup, written with the scalar reads of the levels: the reference the lane
+/// lookup must match bit for bit.
+fn specular_from_levels(environment: &Environment, r: Vec3, roughness: f32) -> Vec3 {
+    let d = r.normalize_or_zero();
+    let last = (SPECULAR_LEVELS - 1) as f32;
+    let lod = if roughness.is_finite() {
+        (roughness * last).clamp(0.0, last)
+    } else {
+        last
+    };
+    let level = lod.floor();
+    let t = lod - level;
+    let lo = environment.levels[level as usize].sample(d);
+    if t == 0.0 {
+        return lo;
+    }
+    let hi = environment.levels[(level as usize + 1).min(SPECULAR_LEVELS - 1)].sample(d);
+    lo + (hi - lo) * t
+}
+
+/// The split-sum lookup with scalar reads of the table.
+fn brdf_from_table(n_dot_v: f32, roughness: f32) -> [f32; 2] {
+    let n = BRDF_TABLE_SIZE as f32;
+    let coordinate = |v: f32| {
+        let v = if v.is_finite() { v } else { 1.0 };
+        (v * n - 0.5).clamp(0.0, n - 1.0)
+    };
+    let (x, y) = (coordinate(n_dot_v), coordinate(roughness));
+    let (x0, y0) = (x.floor(), y.floor());
+    let (fx, fy) = (x - x0, y - y0);
+    let size = BRDF_TABLE_SIZE;
+    let (x0, y0) = (x0 as usize, y0 as usize);
+    let (x1, y1) = ((x0 + 1).min(size - 1), (y0 + 1).min(size - 1));
+    let t = |x: usize, y: usize| brdf_table()[y * size + x];
+    let mut out = [0.0; 2];
+    for (c, o) in out.iter_mut().enumerate() {
+        let top = t(x0, y0)[c] + (t(x1, y0)[c] - t(x0, y0)[c]) * fx;
+        let bottom = t(x0, y1)[c] + (t(x1, y1)[c] - t(x0, y1)[c]) * fx;
+        *o = top + (bottom - top) * fy;
+    }
+    out
+}
+
+/// Eight lanes of lookups: specular radiance and the split-sum terms.
+struct Lookups<'a> {
+    light: &'a EnvironmentLight,
+    directions: [Vec3; 8],
+    roughness: [f32; 8],
+    n_dot_v: [f32; 8],
+}
+
+impl LaneKernel for Lookups<'_> {
+    type Output = [[f32; 8]; 5];
+
+    fn run<L: Lanes>(self, lanes: L) -> Self::Output {
+        let component = |c: usize| lanes.f32_from_array(self.directions.map(|d| d[c]));
+        let r = [component(0), component(1), component(2)];
+        let roughness = lanes.f32_from_array(self.roughness);
+        let s = self.light.specular_lanes(lanes, &r, roughness);
+        let ab = self
+            .light
+            .brdf_lanes(lanes, lanes.f32_from_array(self.n_dot_v), roughness);
+        [
+            s[0].to_array(),
+            s[1].to_array(),
+            s[2].to_array(),
+            ab[0].to_array(),
+            ab[1].to_array(),
+        ]
+    }
+}
+
+/// Each lane of the lane lookups reads its own levels and cells: the same bits as the scalar
+/// reads of the levels and the table, on every instruction set, for directions all around
+/// (unit or not, zero), every roughness between the levels and outside [0, 1], and NaN.
+#[test]
+fn lane_lookups_read_the_levels_bit_for_bit() {
+    let light = EnvironmentLight::studio();
+    let n = 400;
+    let mut lookups = Vec::new();
+    for chunk in 0..n / 8 {
+        let mut directions = [Vec3::ZERO; 8];
+        let mut roughness = [0.0f32; 8];
+        let mut n_dot_v = [0.0f32; 8];
+        for k in 0..8 {
+            let i = chunk * 8 + k;
+            directions[k] = if i == 5 { Vec3::ZERO } else { spiral(i, n) };
+            roughness[k] = match i % 29 {
+                27 => f32::NAN,
+                28 => 1.7,
+                j => j as f32 / 25.0 - 0.04,
+            };
+            n_dot_v[k] = match i % 31 {
+                30 => f32::INFINITY,
+                j => j as f32 / 28.0 - 0.05,
+            };
+        }
+        lookups.push((directions, roughness, n_dot_v));
+    }
+    for isa in Isa::supported() {
+        for &(directions, roughness, n_dot_v) in &lookups {
+            let got = dispatch(
+                isa,
+                Lookups {
+                    light: &light,
+                    directions,
+                    roughness,
+                    n_dot_v,
+                },
+            );
+            for k in 0..8 {
+                let expected =
+                    specular_from_levels(&light.environment, directions[k], roughness[k]);
+                let [a, b] = brdf_from_table(n_dot_v[k], roughness[k]);
+                let lane = [got[0][k], got[1][k], got[2][k], got[3][k], got[4][k]];
+                assert_eq!(
+                    lane.map(f32::to_bits),
+                    [expected.x, expected.y, expected.z, a, b].map(f32::to_bits),
+                    "{isa}: direction {}, roughness {}, NdotV {}",
+                    directions[k],
+                    roughness[k],
+                    n_dot_v[k]
+                );
+            }
+        }
+    }
 }
