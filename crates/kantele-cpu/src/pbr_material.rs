@@ -7,7 +7,10 @@
 //! normal — the interpolated world normal, bent by the normal texture in the tangent frame
 //! derived from the screen-space derivatives of the world position and the texture coordinate
 //! (as the glTF sample viewer does for meshes without tangents); then
-//! [`pbr::shade`], emission, exposure and the tone map.
+//! the dielectric reflectance and specular weight of `KHR_materials_ior` and
+//! `KHR_materials_specular`, the coat of `KHR_materials_clearcoat` (its factor, roughness and
+//! normal texture, bent in the same frame); then [`pbr::shade`] with the emission, exposure
+//! and the tone map.
 //!
 //! One generic routine shades eight fragments at once ([`FragmentLanes`]) and one fragment
 //! ([`Fragment`], every lane holding it), so both follow the same operations.
@@ -22,7 +25,7 @@ use kantele_lanes::{F32x8, Lanes, Mask8, Scalar};
 use kantele_rules::backend::Pass;
 use kantele_rules::camera::normal_matrix;
 use kantele_rules::scene::{AlphaMode, Material};
-use kantele_rules::shade::pbr::{self, normalize3, PbrLighting, Surface};
+use kantele_rules::shade::pbr::{self, normalize3, ClearcoatLayer, PbrLighting, Surface};
 use kantele_rules::shade::texture::{Sampler, Texture};
 
 /// Where the PBR shader's varyings sit.
@@ -53,41 +56,57 @@ pub struct PbrTextures<'a> {
     pub normal: BoundTexture<'a>,
     /// Linear: red = occlusion.
     pub occlusion: BoundTexture<'a>,
+    /// Linear: alpha = specular weight (`KHR_materials_specular`).
+    pub specular: BoundTexture<'a>,
+    /// sRGB: the dielectric reflectance's colour (`KHR_materials_specular`).
+    pub specular_color: BoundTexture<'a>,
+    /// Linear: red = clear coat weight (`KHR_materials_clearcoat`).
+    pub clearcoat: BoundTexture<'a>,
+    /// Linear: green = clear coat roughness.
+    pub clearcoat_roughness: BoundTexture<'a>,
+    /// Linear tangent-space normal of the clear coat.
+    pub clearcoat_normal: BoundTexture<'a>,
 }
 
 impl<'a> PbrTextures<'a> {
     fn any(&self) -> bool {
-        self.base_color.is_some()
-            || self.emissive.is_some()
-            || self.metallic_roughness.is_some()
-            || self.normal.is_some()
-            || self.occlusion.is_some()
+        self.slots().iter().any(|(_, bound)| bound.is_some())
+    }
+
+    /// Every texture with its slot of [`Texels`].
+    fn slots(&self) -> [(usize, BoundTexture<'a>); SLOTS] {
+        [
+            (BASE_COLOR, self.base_color),
+            (EMISSIVE, self.emissive),
+            (METALLIC_ROUGHNESS, self.metallic_roughness),
+            (NORMAL, self.normal),
+            (OCCLUSION, self.occlusion),
+            (SPECULAR, self.specular),
+            (SPECULAR_COLOR, self.specular_color),
+            (CLEARCOAT, self.clearcoat),
+            (CLEARCOAT_ROUGHNESS, self.clearcoat_roughness),
+            (CLEARCOAT_NORMAL, self.clearcoat_normal),
+        ]
     }
 
     /// The textures a draw of `pass` reads, with the slot of [`Texels`] each fills: all of
-    /// them for colour; the base colour (for its alpha, where the material tests it) and the
-    /// normal texture for normals; the base colour for ids, where alpha is tested.
-    fn reads(&self, pass: Pass, alpha_tested: bool) -> TextureReads<'a> {
+    /// them for colour (the clear coat's only with a coat); the base colour (for its alpha,
+    /// where the material tests it) and the normal texture for normals; the base colour for
+    /// ids, where alpha is tested.
+    fn reads(&self, pass: Pass, alpha_tested: bool, clearcoat: bool) -> TextureReads<'a> {
         let mut reads = TextureReads {
             reads: [None; SLOTS],
             count: 0,
         };
-        let slots = [
-            (
-                BASE_COLOR,
-                self.base_color,
-                pass == Pass::Color || alpha_tested,
-            ),
-            (EMISSIVE, self.emissive, pass == Pass::Color),
-            (
-                METALLIC_ROUGHNESS,
-                self.metallic_roughness,
-                pass == Pass::Color,
-            ),
-            (NORMAL, self.normal, pass != Pass::Ids),
-            (OCCLUSION, self.occlusion, pass == Pass::Color),
-        ];
-        for (slot, bound, wanted) in slots {
+        for (slot, bound) in self.slots() {
+            let wanted = match slot {
+                BASE_COLOR => pass == Pass::Color || alpha_tested,
+                NORMAL => pass != Pass::Ids,
+                CLEARCOAT | CLEARCOAT_ROUGHNESS | CLEARCOAT_NORMAL => {
+                    pass == Pass::Color && clearcoat
+                }
+                _ => pass == Pass::Color,
+            };
             if let (Some((texture, sampler)), true) = (bound, wanted) {
                 reads.reads[reads.count] = Some((slot, texture, sampler));
                 reads.count += 1;
@@ -103,7 +122,12 @@ const EMISSIVE: usize = 1;
 const METALLIC_ROUGHNESS: usize = 2;
 const NORMAL: usize = 3;
 const OCCLUSION: usize = 4;
-const SLOTS: usize = 5;
+const SPECULAR: usize = 5;
+const SPECULAR_COLOR: usize = 6;
+const CLEARCOAT: usize = 7;
+const CLEARCOAT_ROUGHNESS: usize = 8;
+const CLEARCOAT_NORMAL: usize = 9;
+const SLOTS: usize = 10;
 
 /// The texels of a fragment's textures, by slot (1 where a texture is not read).
 type Texels<L> = [[<L as Lanes>::F32; 4]; SLOTS];
@@ -152,7 +176,7 @@ impl<'a> PbrShader<'a> {
             lighting,
             material,
             textures,
-            reads: textures.reads(pass, alpha_tested),
+            reads: textures.reads(pass, alpha_tested, material.has_clearcoat()),
             pass,
             ids: (ids.0 as f32, ids.1 as f32),
             vertex_colors: true,
@@ -311,7 +335,7 @@ impl PbrShader<'_> {
         if self.pass == Pass::Ids {
             return (self.ids_lanes(lanes, f.primitive_id()), keep);
         }
-        let normal = self.normal(f, &texels);
+        let [normal, coat_normal] = self.normals(f, &texels);
         if self.pass == Pass::Normals {
             return ([normal[0], normal[1], normal[2], one], keep);
         }
@@ -323,8 +347,12 @@ impl PbrShader<'_> {
                 emissive[c] = emissive[c] * texels[EMISSIVE][c];
             }
         }
-        let lit = if m.unlit {
-            [base[0], base[1], base[2]]
+        let rgb = if m.unlit {
+            [
+                base[0] + emissive[0],
+                base[1] + emissive[1],
+                base[2] + emissive[2],
+            ]
         } else {
             let mut metallic = lanes.splat_f32(m.metallic);
             let mut roughness = lanes.splat_f32(m.roughness);
@@ -339,6 +367,33 @@ impl PbrShader<'_> {
                 let texel = texels[OCCLUSION];
                 occlusion = one + lanes.splat_f32(m.occlusion_strength) * (texel[0] - one);
             }
+            // KHR_materials_ior and KHR_materials_specular.
+            let mut dielectric_f0 = m.dielectric_f0.to_array().map(|c| lanes.splat_f32(c));
+            if self.textures.specular_color.is_some() {
+                for c in 0..3 {
+                    dielectric_f0[c] = dielectric_f0[c] * texels[SPECULAR_COLOR][c];
+                }
+            }
+            let mut specular_weight = lanes.splat_f32(m.specular_weight);
+            if self.textures.specular.is_some() {
+                specular_weight = specular_weight * texels[SPECULAR][3];
+            }
+            // KHR_materials_clearcoat.
+            let clearcoat = m.has_clearcoat().then(|| {
+                let mut factor = lanes.splat_f32(m.clearcoat);
+                if self.textures.clearcoat.is_some() {
+                    factor = factor * texels[CLEARCOAT][0];
+                }
+                let mut roughness = lanes.splat_f32(m.clearcoat_roughness);
+                if self.textures.clearcoat_roughness.is_some() {
+                    roughness = roughness * texels[CLEARCOAT_ROUGHNESS][1];
+                }
+                ClearcoatLayer {
+                    factor: clamp(factor),
+                    roughness: clamp(roughness),
+                    normal: coat_normal,
+                }
+            });
             let surface = Surface {
                 base: [base[0], base[1], base[2]],
                 metallic: clamp(metallic),
@@ -350,22 +405,22 @@ impl PbrShader<'_> {
                     f.varying(at::POSITION + 1),
                     f.varying(at::POSITION + 2),
                 ],
+                dielectric_f0: dielectric_f0.map(|c| c.min(one)),
+                specular_weight: clamp(specular_weight),
+                clearcoat,
             };
-            pbr::shade(lanes, self.lighting, &surface)
+            pbr::shade(lanes, self.lighting, &surface, &emissive)
         };
-        let rgb = [
-            lit[0] + emissive[0],
-            lit[1] + emissive[1],
-            lit[2] + emissive[2],
-        ];
         let [r, g, b] = pbr::tonemap(lanes, self.lighting.tonemap, self.lighting.exposure, rgb);
         ([r, g, b, alpha], keep)
     }
 
-    /// The shading normal: the interpolated normal, bent by the normal texture (see the module
-    /// docs), flipped on back faces of double-sided materials.
+    /// The shading normals of the material and of its clear coat: the interpolated normal,
+    /// bent by the normal texture and by the coat's normal texture (each where the material has
+    /// one) in the derivative tangent frame ([`PbrShader::tangent_frame`]), flipped on back
+    /// faces of double-sided materials.
     #[inline(always)]
-    fn normal<L: Lanes, F: Fragments<L>>(&self, f: &F, texels: &Texels<L>) -> [L::F32; 3] {
+    fn normals<L: Lanes, F: Fragments<L>>(&self, f: &F, texels: &Texels<L>) -> [[L::F32; 3]; 2] {
         let lanes = f.lanes();
         let ng = normalize3(
             lanes,
@@ -375,31 +430,36 @@ impl PbrShader<'_> {
                 f.varying(at::NORMAL + 2),
             ],
         );
-        let mut n = ng;
-        if self.textures.normal.is_some() {
-            n = self.bent_normal(f, ng, texels[NORMAL]);
+        let m = self.material;
+        let bent = self.textures.normal.is_some();
+        let coat_bent = self.textures.clearcoat_normal.is_some()
+            && m.has_clearcoat()
+            && self.pass == Pass::Color;
+        let mut normals = [ng, ng];
+        if bent || coat_bent {
+            let frame = self.tangent_frame(f, ng);
+            if bent {
+                normals[0] = bend(lanes, &frame, ng, texels[NORMAL], m.normal_scale);
+            }
+            if coat_bent {
+                let texel = texels[CLEARCOAT_NORMAL];
+                normals[1] = bend(lanes, &frame, ng, texel, m.clearcoat_normal_scale);
+            }
         }
-        if self.material.double_sided && !f.front_facing() {
-            [-n[0], -n[1], -n[2]]
+        if m.double_sided && !f.front_facing() {
+            normals.map(|n| n.map(|c| -c))
         } else {
-            n
+            normals
         }
     }
 
-    /// `ng` bent by the normal texture's `texel` in the derivative tangent frame: `t_ = (∂v/∂y ∂p/∂x −
-    /// ∂v/∂x ∂p/∂y) / det` with `det = ∂u/∂x ∂v/∂y − ∂u/∂y ∂v/∂x`, `t = normalize(t_ − ng
-    /// (ng·t_))`, `b = ±ng × t` (negative where the mapping is mirrored: `det < 0` on a front
-    /// face, `det > 0` on a back face), `n = normalize(t m.x + b m.y + ng m.z)` with `m = 2
-    /// texel − 1`, `m.xy ×= scale`; `ng` where the frame is degenerate.
+    /// The derivative tangent frame `[t, b]` around `ng`: `t_ = (∂v/∂y ∂p/∂x − ∂v/∂x ∂p/∂y) /
+    /// det` with `det = ∂u/∂x ∂v/∂y − ∂u/∂y ∂v/∂x`, `t = normalize(t_ − ng (ng·t_))` (0 where
+    /// degenerate), `b = ±ng × t` (negative where the mapping is mirrored: `det < 0` on a front
+    /// face, `det > 0` on a back face).
     #[inline(always)]
-    fn bent_normal<L: Lanes, F: Fragments<L>>(
-        &self,
-        f: &F,
-        ng: [L::F32; 3],
-        texel: [L::F32; 4],
-    ) -> [L::F32; 3] {
+    fn tangent_frame<L: Lanes, F: Fragments<L>>(&self, f: &F, ng: [L::F32; 3]) -> [[L::F32; 3]; 2] {
         let lanes = f.lanes();
-        let one = lanes.splat_f32(1.0);
         let (du_dx, du_dy) = f.derivatives(at::TEXCOORD);
         let (dv_dx, dv_dy) = f.derivatives(at::TEXCOORD + 1);
         let mut dp_dx = [lanes.splat_f32(0.0); 3];
@@ -441,37 +501,7 @@ impl PbrShader<'_> {
             mirrored.select_f32(-b[1], b[1]),
             mirrored.select_f32(-b[2], b[2]),
         ];
-        let two = lanes.splat_f32(2.0);
-        let scale = lanes.splat_f32(self.material.normal_scale);
-        let m = [
-            (texel[0] * two - one) * scale,
-            (texel[1] * two - one) * scale,
-            texel[2] * two - one,
-        ];
-        let bent = normalize3(
-            lanes,
-            [
-                t[0] * m[0] + b[0] * m[1] + ng[0] * m[2],
-                t[1] * m[0] + b[1] * m[1] + ng[1] * m[2],
-                t[2] * m[0] + b[2] * m[1] + ng[2] * m[2],
-            ],
-        );
-        // normalize3 gives 0 for a degenerate frame (t) or result: keep ng there.
-        let usable = (t[0]
-            .simd_ne(zero)
-            .or(t[1].simd_ne(zero))
-            .or(t[2].simd_ne(zero)))
-        .and(
-            bent[0]
-                .simd_ne(zero)
-                .or(bent[1].simd_ne(zero))
-                .or(bent[2].simd_ne(zero)),
-        );
-        [
-            usable.select_f32(bent[0], ng[0]),
-            usable.select_f32(bent[1], ng[1]),
-            usable.select_f32(bent[2], ng[2]),
-        ]
+        [t, b]
     }
 
     #[inline(always)]
@@ -483,6 +513,52 @@ impl PbrShader<'_> {
             lanes.splat_f32(1.0),
         ]
     }
+}
+
+/// `ng` bent by a normal texture's `texel` in the tangent frame `[t, b]`
+/// ([`PbrShader::tangent_frame`]): `n = normalize(t m.x + b m.y + ng m.z)` with `m = 2 texel −
+/// 1`, `m.xy ×= scale`; `ng` where the frame or the result is degenerate.
+#[inline(always)]
+fn bend<L: Lanes>(
+    lanes: L,
+    [t, b]: &[[L::F32; 3]; 2],
+    ng: [L::F32; 3],
+    texel: [L::F32; 4],
+    scale: f32,
+) -> [L::F32; 3] {
+    let one = lanes.splat_f32(1.0);
+    let zero = lanes.splat_f32(0.0);
+    let two = lanes.splat_f32(2.0);
+    let scale = lanes.splat_f32(scale);
+    let m = [
+        (texel[0] * two - one) * scale,
+        (texel[1] * two - one) * scale,
+        texel[2] * two - one,
+    ];
+    let bent = normalize3(
+        lanes,
+        [
+            t[0] * m[0] + b[0] * m[1] + ng[0] * m[2],
+            t[1] * m[0] + b[1] * m[1] + ng[1] * m[2],
+            t[2] * m[0] + b[2] * m[1] + ng[2] * m[2],
+        ],
+    );
+    // normalize3 gives 0 for a degenerate frame (t) or result: keep ng there.
+    let usable = (t[0]
+        .simd_ne(zero)
+        .or(t[1].simd_ne(zero))
+        .or(t[2].simd_ne(zero)))
+    .and(
+        bent[0]
+            .simd_ne(zero)
+            .or(bent[1].simd_ne(zero))
+            .or(bent[2].simd_ne(zero)),
+    );
+    [
+        usable.select_f32(bent[0], ng[0]),
+        usable.select_f32(bent[1], ng[1]),
+        usable.select_f32(bent[2], ng[2]),
+    ]
 }
 
 impl Shader for PbrShader<'_> {

@@ -118,9 +118,9 @@ fn render<S: Shader<Vertex = StandardVertex>>(
     renderer.framebuffer().read_color()
 }
 
-/// Every instruction set shades a fully textured, normal-mapped, environment-lit quad to the
-/// same bits, and one fragment at a time (the scalar texture sampler) agrees within the
-/// samplers' rounding.
+/// Every instruction set shades a fully textured, normal-mapped, clear-coated, environment-lit
+/// quad to the same bits, and one fragment at a time (the scalar texture sampler) agrees within
+/// the samplers' rounding.
 #[test]
 fn lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time() {
     let base = linear_texture(16, |x, y| [(x * 16) as u8, (y * 16) as u8, 128, 255]);
@@ -136,6 +136,11 @@ fn lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time() {
         roughness: 0.9,
         normal_scale: 0.7,
         occlusion_strength: 0.5,
+        dielectric_f0: Vec3::new(0.08, 0.05, 0.02),
+        specular_weight: 0.8,
+        clearcoat: 0.9,
+        clearcoat_roughness: 0.6,
+        clearcoat_normal_scale: 1.2,
         ..Material::default()
     };
     let textures = PbrTextures {
@@ -144,6 +149,11 @@ fn lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time() {
         metallic_roughness: Some((&mr, sampler())),
         normal: Some((&bumps, sampler())),
         occlusion: Some((&occlusion, sampler())),
+        specular: Some((&base, sampler())),
+        specular_color: Some((&occlusion, sampler())),
+        clearcoat: Some((&mr, sampler())),
+        clearcoat_roughness: Some((&occlusion, sampler())),
+        clearcoat_normal: Some((&bumps, sampler())),
     };
     let lighting = lighting(true);
     let model = Mat4::from_rotation_y(0.4) * Mat4::from_rotation_x(-0.3);

@@ -228,7 +228,6 @@ impl GlBackend {
     ) {
         let gl = &self.gl;
         let u = &self.pbr_uniforms;
-        let [metallic_roughness, normal, occlusion] = material.pbr_textures();
         let samplers = self.gpu.pbr_samplers[material_index];
         // SAFETY: caller's contract; the textures and samplers are ours and alive.
         unsafe {
@@ -237,21 +236,22 @@ impl GlBackend {
             gl.uniform_1_f32(u.roughness.as_ref(), material.roughness);
             gl.uniform_1_f32(u.normal_scale.as_ref(), material.normal_scale);
             gl.uniform_1_f32(u.occlusion_strength.as_ref(), material.occlusion_strength);
-            for (binding, sampler, unit, has) in [
-                (
-                    metallic_roughness,
-                    samplers[0],
-                    pbr::UNIT_METALLIC_ROUGHNESS,
-                    &u.has_metallic_roughness_texture,
-                ),
-                (normal, samplers[1], pbr::UNIT_NORMAL, &u.has_normal_texture),
-                (
-                    occlusion,
-                    samplers[2],
-                    pbr::UNIT_OCCLUSION,
-                    &u.has_occlusion_texture,
-                ),
-            ] {
+            gl.uniform_3_f32_slice(u.dielectric_f0.as_ref(), &material.dielectric_f0.to_array());
+            gl.uniform_1_f32(u.specular_weight.as_ref(), material.specular_weight);
+            gl.uniform_1_f32(u.clearcoat.as_ref(), material.clearcoat);
+            gl.uniform_1_f32(u.clearcoat_roughness.as_ref(), material.clearcoat_roughness);
+            gl.uniform_1_f32(
+                u.clearcoat_normal_scale.as_ref(),
+                material.clearcoat_normal_scale,
+            );
+            for (k, ((binding, sampler), [has, _])) in material
+                .pbr_textures()
+                .into_iter()
+                .zip(samplers)
+                .zip(&u.textures)
+                .enumerate()
+            {
+                let unit = pbr::FIRST_PBR_UNIT + k as u32;
                 gl.active_texture(glow::TEXTURE0 + unit);
                 gl.uniform_1_i32(has.as_ref(), binding.is_some() as i32);
                 gl.bind_texture(

@@ -24,16 +24,34 @@ use kantele_rules::shade::pbr::{
 use crate::program::{uniforms, Uniforms};
 use crate::resources::GpuEnvironment;
 
-/// Texture unit of the metallic-roughness texture (0 and 1 are the base colour and emissive).
-pub(crate) const UNIT_METALLIC_ROUGHNESS: u32 = 2;
-/// Texture unit of the normal texture.
-pub(crate) const UNIT_NORMAL: u32 = 3;
-/// Texture unit of the occlusion texture.
-pub(crate) const UNIT_OCCLUSION: u32 = 4;
+/// The program's material textures besides the base colour and emissive ones, in the order of
+/// [`Material::pbr_textures`](kantele_rules::scene::Material::pbr_textures): the names of
+/// their `u_has_*` flag and sampler uniforms. Texture `k` is on unit [`FIRST_PBR_UNIT`] + `k`.
+pub(crate) const PBR_TEXTURES: [(&str, &str); 8] = [
+    (
+        "u_has_metallic_roughness_texture",
+        "u_metallic_roughness_texture",
+    ),
+    ("u_has_normal_texture", "u_normal_texture"),
+    ("u_has_occlusion_texture", "u_occlusion_texture"),
+    ("u_has_specular_texture", "u_specular_texture"),
+    ("u_has_specular_color_texture", "u_specular_color_texture"),
+    ("u_has_clearcoat_texture", "u_clearcoat_texture"),
+    (
+        "u_has_clearcoat_roughness_texture",
+        "u_clearcoat_roughness_texture",
+    ),
+    (
+        "u_has_clearcoat_normal_texture",
+        "u_clearcoat_normal_texture",
+    ),
+];
+/// Texture unit of the first of [`PBR_TEXTURES`] (0 and 1 are the base colour and emissive).
+pub(crate) const FIRST_PBR_UNIT: u32 = 2;
 /// Texture unit of the environment's level atlas.
-pub(crate) const UNIT_ENVIRONMENT: u32 = 5;
+pub(crate) const UNIT_ENVIRONMENT: u32 = FIRST_PBR_UNIT + PBR_TEXTURES.len() as u32;
 /// Texture unit of the split-sum table.
-pub(crate) const UNIT_BRDF: u32 = 6;
+pub(crate) const UNIT_BRDF: u32 = UNIT_ENVIRONMENT + 1;
 
 /// The vertex shader: the Lambert program's, plus the world position for the fragment shader.
 pub(crate) const VERTEX: &str = r#"#version 330 core
@@ -94,6 +112,23 @@ uniform float u_normal_scale;
 uniform bool u_has_occlusion_texture;
 uniform sampler2D u_occlusion_texture;
 uniform float u_occlusion_strength;
+// KHR_materials_ior and KHR_materials_specular.
+uniform vec3 u_dielectric_f0;
+uniform float u_specular_weight;
+uniform bool u_has_specular_texture;
+uniform sampler2D u_specular_texture;
+uniform bool u_has_specular_color_texture;
+uniform sampler2D u_specular_color_texture;
+// KHR_materials_clearcoat (u_clearcoat 0: no coat).
+uniform float u_clearcoat;
+uniform bool u_has_clearcoat_texture;
+uniform sampler2D u_clearcoat_texture;
+uniform float u_clearcoat_roughness;
+uniform bool u_has_clearcoat_roughness_texture;
+uniform sampler2D u_clearcoat_roughness_texture;
+uniform bool u_has_clearcoat_normal_texture;
+uniform sampler2D u_clearcoat_normal_texture;
+uniform float u_clearcoat_normal_scale;
 
 // PbrLighting: the eye, the punctual lights (FrameLight, as u_punctual_*: u_light_color is
 // the Lambert program's), exposure scale and tone map.
@@ -153,13 +188,37 @@ float ggx_d_times_v(float alpha, float n_dot_l, float n_dot_v, float n_dot_h) {
     return d * v;
 }
 
-// pbr::schlick.
-vec3 schlick(vec3 f0, float v_dot_h) {
+// pbr::schlick_weight.
+float schlick_weight(float v_dot_h) {
     float m = 1.0 - v_dot_h;
     float m2 = m * m;
-    float m5 = m2 * m2 * m;
-    return f0 + (1.0 - f0) * m5;
+    return m2 * m2 * m;
 }
+
+// pbr::schlick.
+vec3 schlick(vec3 f0, float f90, float v_dot_h) {
+    return f0 + (f90 - f0) * schlick_weight(v_dot_h);
+}
+
+// pbr::coat_fresnel.
+float coat_fresnel(float v_dot_h) {
+    return DIELECTRIC_F0 + (1.0 - DIELECTRIC_F0) * schlick_weight(v_dot_h);
+}
+
+// pbr::Surface (less what the fragment shader reads directly) and pbr::Reflectance.
+struct Surface {
+    vec3 n;
+    float roughness;
+    float occlusion;
+    vec3 position;
+    vec3 c_diff;
+    vec3 f0;
+    float f90;
+    bool coat;
+    float coat_factor;
+    float coat_roughness;
+    vec3 coat_n;
+};
 
 // pbr::light_arrival: the unit vector towards light i and the attenuation.
 void light_arrival(int i, vec3 position, out vec3 l, out float attenuation) {
@@ -186,20 +245,32 @@ void light_arrival(int i, vec3 position, out vec3 l, out float attenuation) {
     attenuation = is_finite(a) ? a : 0.0;
 }
 
-// pbr::punctual.
-vec3 punctual(int i, vec3 n, vec3 position, vec3 view, vec3 c_diff, vec3 f0, float alpha) {
+// pbr::punctual: light i on the surface, and on its coat (into `coat`).
+vec3 punctual(int i, Surface s, vec3 view, float alpha, out vec3 coat) {
     vec3 l;
     float attenuation;
-    light_arrival(i, position, l, attenuation);
+    light_arrival(i, s.position, l, attenuation);
+    vec3 n = s.n;
     vec3 h = normalize3(view + l);
     float n_dot_l = clamp01(dot3(n, l));
     float n_dot_v = clamp01(dot3(n, view));
     float n_dot_h = clamp01(dot3(n, h));
     float v_dot_h = clamp01(dot3(view, h));
-    vec3 f = schlick(f0, v_dot_h);
+    vec3 f = schlick(s.f0, s.f90, v_dot_h);
     float dv = ggx_d_times_v(alpha, n_dot_l, n_dot_v, n_dot_h);
     float scale = attenuation * n_dot_l;
-    vec3 brdf = (1.0 - f) * c_diff * INV_PI + f * dv;
+    vec3 brdf = (1.0 - f) * s.c_diff * INV_PI + f * dv;
+    coat = vec3(0.0);
+    if (s.coat) {
+        vec3 nc = s.coat_n;
+        float c_n_dot_l = clamp01(dot3(nc, l));
+        float c_n_dot_v = clamp01(dot3(nc, view));
+        float c_n_dot_h = clamp01(dot3(nc, h));
+        float clamped = max(s.coat_roughness, MIN_PUNCTUAL_ROUGHNESS);
+        float c_dv = ggx_d_times_v(clamped * clamped, c_n_dot_l, c_n_dot_v, c_n_dot_h);
+        float lobe = attenuation * c_n_dot_l * coat_fresnel(v_dot_h) * c_dv;
+        coat = u_punctual_color[i] * lobe;
+    }
     return u_punctual_color[i] * scale * brdf;
 }
 
@@ -316,38 +387,70 @@ vec2 brdf_ab(float n_dot_v, float roughness) {
     return top + (bottom - top) * fy;
 }
 
-// pbr::image_based.
-vec3 image_based(vec3 n, vec3 view, vec3 c_diff, vec3 f0, float roughness, float occlusion) {
+// pbr::image_based, one lobe: the pre-filtered radiance along the reflection about n and the
+// split-sum terms (A, B).
+void environment_lobe(vec3 n, vec3 view, float roughness, out vec3 radiance, out vec2 ab) {
     float n_dot_v_raw = dot3(n, view);
     float n_dot_v = clamp01(n_dot_v_raw);
     // R = 2 (N.V) N - V.
     float two_n_dot_v = n_dot_v_raw + n_dot_v_raw;
     vec3 reflected = two_n_dot_v * n - view;
-    vec3 irradiance_ = irradiance(n);
-    vec3 specular_ = specular(reflected, roughness);
-    vec2 ab = brdf_ab(n_dot_v, roughness);
-    float weight = occlusion * u_environment_intensity;
-    vec3 fss_ess = f0 * ab.x + ab.y;
-    vec3 diffuse = irradiance_ * c_diff * (1.0 - fss_ess);
+    radiance = specular(reflected, roughness);
+    ab = brdf_ab(n_dot_v, roughness);
+}
+
+// pbr::image_based: the light under the coat, and the coat's (into `coat`).
+vec3 image_based(Surface s, vec3 view, out vec3 coat) {
+    vec3 specular_;
+    vec2 ab;
+    environment_lobe(s.n, view, s.roughness, specular_, ab);
+    vec3 irradiance_ = irradiance(s.n);
+    float weight = s.occlusion * u_environment_intensity;
+    vec3 fss_ess = s.f0 * ab.x + s.f90 * ab.y;
+    vec3 diffuse = irradiance_ * s.c_diff * (1.0 - fss_ess);
+    coat = vec3(0.0);
+    if (s.coat) {
+        vec3 coat_specular;
+        vec2 coat_ab;
+        environment_lobe(s.coat_n, view, s.coat_roughness, coat_specular, coat_ab);
+        float coat_fss_ess = DIELECTRIC_F0 * coat_ab.x + coat_ab.y;
+        coat = coat_specular * coat_fss_ess * weight;
+    }
     return (diffuse + specular_ * fss_ess) * weight;
 }
 
-// pbr::shade: the linear colour before exposure and tone mapping.
-vec3 shade(vec3 base, float metallic, float roughness, float occlusion, vec3 n, vec3 position) {
-    vec3 view = normalize3(u_eye - position);
-    float dielectric = 1.0 - metallic;
-    vec3 c_diff = base * dielectric;
-    vec3 f0 = DIELECTRIC_F0 + (base - DIELECTRIC_F0) * metallic;
-    float clamped = max(roughness, MIN_PUNCTUAL_ROUGHNESS);
+// pbr::shade: the linear colour before exposure and tone mapping, emission and coat included.
+vec3 shade(Surface s, vec3 emissive) {
+    vec3 view = normalize3(u_eye - s.position);
+    float clamped = max(s.roughness, MIN_PUNCTUAL_ROUGHNESS);
     float alpha = clamped * clamped;
     vec3 color = vec3(0.0);
+    vec3 coat_color = vec3(0.0);
     for (int i = 0; i < u_punctual_count; i++) {
-        color = color + punctual(i, n, position, view, c_diff, f0, alpha);
+        vec3 coat;
+        color = color + punctual(i, s, view, alpha, coat);
+        coat_color = coat_color + coat;
     }
     if (u_has_environment) {
-        color = color + image_based(n, view, c_diff, f0, roughness, occlusion);
+        vec3 coat;
+        color = color + image_based(s, view, coat);
+        coat_color = coat_color + coat;
+    }
+    color = color + emissive;
+    if (s.coat) {
+        float under = 1.0 - s.coat_factor * coat_fresnel(clamp01(dot3(s.coat_n, view)));
+        color = color * under + s.coat_factor * coat_color;
     }
     return color;
+}
+
+// The normal texture's texel bent into the tangent frame (t, b) around ng (PbrShader's bend).
+vec3 bend(vec3 t, vec3 b, vec3 ng, vec4 texel, float scale) {
+    vec3 m = texel.rgb * 2.0 - 1.0;
+    m.x = m.x * scale;
+    m.y = m.y * scale;
+    vec3 bent = normalize3(t * m.x + b * m.y + ng * m.z);
+    return bent != vec3(0.0) ? bent : ng;
 }
 
 // pbr::pbr_neutral (Khronos PBR Neutral).
@@ -408,6 +511,26 @@ void main() {
     if (u_has_emissive_texture) {
         emissive *= texture(u_emissive_texture, v_texcoord).rgb;
     }
+    vec4 specular_texel = vec4(1.0);
+    if (u_has_specular_texture) {
+        specular_texel = texture(u_specular_texture, v_texcoord);
+    }
+    vec4 specular_color_texel = vec4(1.0);
+    if (u_has_specular_color_texture) {
+        specular_color_texel = texture(u_specular_color_texture, v_texcoord);
+    }
+    vec4 clearcoat_texel = vec4(1.0);
+    if (u_has_clearcoat_texture) {
+        clearcoat_texel = texture(u_clearcoat_texture, v_texcoord);
+    }
+    vec4 clearcoat_roughness_texel = vec4(1.0);
+    if (u_has_clearcoat_roughness_texture) {
+        clearcoat_roughness_texel = texture(u_clearcoat_roughness_texture, v_texcoord);
+    }
+    vec4 clearcoat_normal_texel = vec4(0.5, 0.5, 1.0, 1.0);
+    if (u_has_clearcoat_normal_texture) {
+        clearcoat_normal_texel = texture(u_clearcoat_normal_texture, v_texcoord);
+    }
     // The projection is y-flipped (window row 0 = image row 0), so dFdy is the derivative
     // towards increasing image row, as the CPU's.
     vec3 dp_dx = dFdx(v_position);
@@ -434,7 +557,9 @@ void main() {
 
     vec3 ng = normalize3(v_normal);
     vec3 n = ng;
-    if (u_has_normal_texture) {
+    bool coat = u_clearcoat > 0.0;
+    vec3 coat_n = ng;
+    if (u_has_normal_texture || (coat && u_has_clearcoat_normal_texture)) {
         // The tangent from the screen-space derivatives of position and texture coordinate.
         float du_dx = duv_dx.x;
         float dv_dx = duv_dx.y;
@@ -451,16 +576,19 @@ void main() {
             if ((det < 0.0) != !gl_FrontFacing) {
                 b = -b;
             }
-            vec3 m = normal_texel.rgb * 2.0 - 1.0;
-            m.x = m.x * u_normal_scale;
-            m.y = m.y * u_normal_scale;
-            n = normalize3(t * m.x + b * m.y + ng * m.z);
+            if (u_has_normal_texture) {
+                n = bend(t, b, ng, normal_texel, u_normal_scale);
+            }
+            if (coat && u_has_clearcoat_normal_texture) {
+                coat_n = bend(t, b, ng, clearcoat_normal_texel, u_clearcoat_normal_scale);
+            }
         }
     }
     // The projection is y-flipped and glFrontFace is GL_CW, so gl_FrontFacing keeps its meaning:
     // true for triangles counter-clockwise in (unflipped) NDC.
     if (u_double_sided && !gl_FrontFacing) {
         n = -n;
+        coat_n = -coat_n;
     }
     if (u_pass == 1) {
         o_color = vec4(n, 1.0);
@@ -474,7 +602,39 @@ void main() {
     if (u_unlit) {
         rgb = base.rgb + emissive;
     } else {
-        rgb = shade(base.rgb, metallic, roughness, occlusion, n, v_position) + emissive;
+        Surface s;
+        s.n = n;
+        s.roughness = roughness;
+        s.occlusion = occlusion;
+        s.position = v_position;
+        // pbr::reflectance, with KHR_materials_ior and KHR_materials_specular.
+        vec3 dielectric_f0 = u_dielectric_f0;
+        if (u_has_specular_color_texture) {
+            dielectric_f0 = dielectric_f0 * specular_color_texel.rgb;
+        }
+        dielectric_f0 = min(dielectric_f0, vec3(1.0));
+        float w = u_specular_weight;
+        if (u_has_specular_texture) {
+            w = w * specular_texel.a;
+        }
+        w = clamp01(w);
+        s.c_diff = base.rgb * (1.0 - metallic);
+        vec3 weighted = dielectric_f0 * w;
+        s.f0 = weighted + (base.rgb - weighted) * metallic;
+        s.f90 = w + (1.0 - w) * metallic;
+        s.coat = coat;
+        float coat_factor = u_clearcoat;
+        if (u_has_clearcoat_texture) {
+            coat_factor = coat_factor * clearcoat_texel.r;
+        }
+        float coat_roughness = u_clearcoat_roughness;
+        if (u_has_clearcoat_roughness_texture) {
+            coat_roughness = coat_roughness * clearcoat_roughness_texel.g;
+        }
+        s.coat_factor = clamp01(coat_factor);
+        s.coat_roughness = clamp01(coat_roughness);
+        s.coat_n = coat_n;
+        rgb = shade(s, emissive);
     }
     rgb = tonemap(rgb);
     float a = u_alpha_mode == 2 ? base.a : 1.0;
@@ -525,14 +685,15 @@ pub(crate) struct PbrUniforms {
     pub(crate) model: Option<glow::UniformLocation>,
     pub(crate) metallic: Option<glow::UniformLocation>,
     pub(crate) roughness: Option<glow::UniformLocation>,
-    pub(crate) has_metallic_roughness_texture: Option<glow::UniformLocation>,
-    pub(crate) metallic_roughness_texture: Option<glow::UniformLocation>,
-    pub(crate) has_normal_texture: Option<glow::UniformLocation>,
-    pub(crate) normal_texture: Option<glow::UniformLocation>,
+    /// The `u_has_*` flag and the sampler of each of [`PBR_TEXTURES`].
+    pub(crate) textures: [[Option<glow::UniformLocation>; 2]; PBR_TEXTURES.len()],
     pub(crate) normal_scale: Option<glow::UniformLocation>,
-    pub(crate) has_occlusion_texture: Option<glow::UniformLocation>,
-    pub(crate) occlusion_texture: Option<glow::UniformLocation>,
     pub(crate) occlusion_strength: Option<glow::UniformLocation>,
+    pub(crate) dielectric_f0: Option<glow::UniformLocation>,
+    pub(crate) specular_weight: Option<glow::UniformLocation>,
+    pub(crate) clearcoat: Option<glow::UniformLocation>,
+    pub(crate) clearcoat_roughness: Option<glow::UniformLocation>,
+    pub(crate) clearcoat_normal_scale: Option<glow::UniformLocation>,
     pub(crate) eye: Option<glow::UniformLocation>,
     pub(crate) light_count: Option<glow::UniformLocation>,
     pub(crate) light_color: Option<glow::UniformLocation>,
@@ -574,14 +735,14 @@ pub(crate) unsafe fn pbr_uniforms(gl: &glow::Context, program: glow::Program) ->
         model: at("u_model"),
         metallic: at("u_metallic"),
         roughness: at("u_roughness"),
-        has_metallic_roughness_texture: at("u_has_metallic_roughness_texture"),
-        metallic_roughness_texture: at("u_metallic_roughness_texture"),
-        has_normal_texture: at("u_has_normal_texture"),
-        normal_texture: at("u_normal_texture"),
+        textures: PBR_TEXTURES.map(|(has, sampler)| [at(has), at(sampler)]),
         normal_scale: at("u_normal_scale"),
-        has_occlusion_texture: at("u_has_occlusion_texture"),
-        occlusion_texture: at("u_occlusion_texture"),
         occlusion_strength: at("u_occlusion_strength"),
+        dielectric_f0: at("u_dielectric_f0"),
+        specular_weight: at("u_specular_weight"),
+        clearcoat: at("u_clearcoat"),
+        clearcoat_roughness: at("u_clearcoat_roughness"),
+        clearcoat_normal_scale: at("u_clearcoat_normal_scale"),
         eye: at("u_eye"),
         light_count: at("u_punctual_count"),
         light_color: at("u_punctual_color"),
@@ -662,12 +823,9 @@ pub(crate) unsafe fn set_frame_uniforms(
     let unit = |unit: u32| unit as i32;
     // SAFETY: caller's contract; every slice has the length of its uniform array.
     unsafe {
-        gl.uniform_1_i32(
-            u.metallic_roughness_texture.as_ref(),
-            unit(UNIT_METALLIC_ROUGHNESS),
-        );
-        gl.uniform_1_i32(u.normal_texture.as_ref(), unit(UNIT_NORMAL));
-        gl.uniform_1_i32(u.occlusion_texture.as_ref(), unit(UNIT_OCCLUSION));
+        for (k, [_, sampler]) in u.textures.iter().enumerate() {
+            gl.uniform_1_i32(sampler.as_ref(), unit(FIRST_PBR_UNIT + k as u32));
+        }
         gl.uniform_1_i32(u.environment.as_ref(), unit(UNIT_ENVIRONMENT));
         gl.uniform_1_i32(u.brdf.as_ref(), unit(UNIT_BRDF));
         gl.uniform_3_f32_slice(u.eye.as_ref(), &lighting.eye.to_array());

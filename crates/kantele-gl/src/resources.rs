@@ -32,9 +32,9 @@ pub(crate) struct GpuScene {
     pub(crate) samplers: Vec<Option<glow::Sampler>>,
     /// Per material: the sampler object of its emissive texture, if it has one.
     pub(crate) emissive_samplers: Vec<Option<glow::Sampler>>,
-    /// Per material: the sampler objects of its metallic-roughness, normal and occlusion
-    /// textures ([`Material::pbr_textures`]), where it has them.
-    pub(crate) pbr_samplers: Vec<[Option<glow::Sampler>; 3]>,
+    /// Per material: the sampler objects of its PBR textures ([`Material::pbr_textures`]),
+    /// where it has them.
+    pub(crate) pbr_samplers: Vec<[Option<glow::Sampler>; 8]>,
     /// The environment of a PBR scene, if it has one.
     pub(crate) environment: Option<GpuEnvironment>,
 }
@@ -389,7 +389,7 @@ impl GpuScene {
                     None => None,
                 };
                 gpu.emissive_samplers.push(emissive);
-                let mut pbr = [None; 3];
+                let mut pbr = [None; 8];
                 for (slot, binding) in pbr.iter_mut().zip(material.pbr_textures()) {
                     if let Some(b) = binding {
                         // SAFETY: forwarded caller's contract.

@@ -161,6 +161,32 @@ pub struct Material {
     pub occlusion_texture: Option<TextureBinding>,
     /// `occlusion = 1 + strength × (texel − 1)` (`occlusionTexture.strength`).
     pub occlusion_strength: f32,
+    /// Reflectance at normal incidence of the dielectric part, before the specular colour
+    /// texture: `((ior − 1) / (ior + 1))² × specularColorFactor` (`KHR_materials_ior`,
+    /// `KHR_materials_specular`; 0.04 without them). The shading clamps it to 1 after the
+    /// texture.
+    pub dielectric_f0: Vec3,
+    /// `specularFactor`: scales the dielectric part's specular reflection, which the diffuse
+    /// part then makes room for (`KHR_materials_specular`; 1 without it).
+    pub specular_weight: f32,
+    /// Linear texture whose alpha channel multiplies `specular_weight`.
+    pub specular_texture: Option<TextureBinding>,
+    /// sRGB texture whose RGB multiplies `dielectric_f0`.
+    pub specular_color_texture: Option<TextureBinding>,
+    /// `clearcoatFactor`: the weight of a clear coat over the material (`KHR_materials_clearcoat`;
+    /// 0 without it: no coat).
+    pub clearcoat: f32,
+    /// Linear texture whose red channel multiplies `clearcoat`.
+    pub clearcoat_texture: Option<TextureBinding>,
+    /// `clearcoatRoughnessFactor`, perceptual.
+    pub clearcoat_roughness: f32,
+    /// Linear texture whose green channel multiplies `clearcoat_roughness`.
+    pub clearcoat_roughness_texture: Option<TextureBinding>,
+    /// Linear tangent-space normal texture of the coat (without one the coat follows the
+    /// interpolated normal, not the base's normal texture).
+    pub clearcoat_normal_texture: Option<TextureBinding>,
+    /// Scales the coat normal texture's X and Y.
+    pub clearcoat_normal_scale: f32,
 }
 
 impl Default for Material {
@@ -181,19 +207,40 @@ impl Default for Material {
             normal_scale: 1.0,
             occlusion_texture: None,
             occlusion_strength: 1.0,
+            dielectric_f0: Vec3::splat(crate::shade::pbr::DIELECTRIC_F0),
+            specular_weight: 1.0,
+            specular_texture: None,
+            specular_color_texture: None,
+            clearcoat: 0.0,
+            clearcoat_texture: None,
+            clearcoat_roughness: 0.0,
+            clearcoat_roughness_texture: None,
+            clearcoat_normal_texture: None,
+            clearcoat_normal_scale: 1.0,
         }
     }
 }
 
 impl Material {
     /// The material's textures that PBR shading reads besides the base colour and emissive
-    /// ones: metallic-roughness, normal, occlusion.
-    pub fn pbr_textures(&self) -> [Option<TextureBinding>; 3] {
+    /// ones: metallic-roughness, normal, occlusion, specular, specular colour, clear coat,
+    /// clear-coat roughness and clear-coat normal.
+    pub fn pbr_textures(&self) -> [Option<TextureBinding>; 8] {
         [
             self.metallic_roughness_texture,
             self.normal_texture,
             self.occlusion_texture,
+            self.specular_texture,
+            self.specular_color_texture,
+            self.clearcoat_texture,
+            self.clearcoat_roughness_texture,
+            self.clearcoat_normal_texture,
         ]
+    }
+
+    /// Whether the material has a clear coat (`clearcoat > 0`).
+    pub fn has_clearcoat(&self) -> bool {
+        self.clearcoat > 0.0
     }
 }
 
@@ -593,16 +640,11 @@ impl Scene {
             }
         }
         for (i, material) in self.materials.iter().enumerate() {
-            let [metallic_roughness, normal, occlusion] = material.pbr_textures();
-            for binding in [
-                material.base_color_texture,
-                material.emissive_texture,
-                metallic_roughness,
-                normal,
-                occlusion,
-            ]
-            .into_iter()
-            .flatten()
+            let textures = [material.base_color_texture, material.emissive_texture];
+            for binding in textures
+                .into_iter()
+                .chain(material.pbr_textures())
+                .flatten()
             {
                 if binding.texture >= self.textures.len() {
                     return Err(RenderError::InvalidScene(format!(

@@ -145,6 +145,11 @@ impl CpuBackend {
                     metallic_roughness: bound(material.metallic_roughness_texture),
                     normal: bound(material.normal_texture),
                     occlusion: bound(material.occlusion_texture),
+                    specular: bound(material.specular_texture),
+                    specular_color: bound(material.specular_color_texture),
+                    clearcoat: bound(material.clearcoat_texture),
+                    clearcoat_roughness: bound(material.clearcoat_roughness_texture),
+                    clearcoat_normal: bound(material.clearcoat_normal_texture),
                 };
                 PbrShader::new(
                     draw.model,

@@ -20,7 +20,9 @@ use kantele_rules::scene::{
     Draw, LightKind, Material, Mesh, PunctualLight, Scene, Shading, TextureBinding,
 };
 use kantele_rules::shade::environment::EnvironmentLight;
-use kantele_rules::shade::pbr::{shade, tonemap, PbrLighting, Surface, Tonemap};
+use kantele_rules::shade::pbr::{
+    shade, tonemap, ClearcoatLayer, PbrLighting, Surface, Tonemap, DIELECTRIC_F0,
+};
 use kantele_rules::shade::texture::{ColorSpace, Sampler, Texture};
 
 use crate::common::gl_or_skip;
@@ -178,14 +180,36 @@ struct Params {
     occlusion: f32,
     emissive: Vec3,
     unlit: bool,
+    /// Dielectric reflectance and specular weight (`KHR_materials_ior`, `_specular`).
+    dielectric_f0: Vec3,
+    specular_weight: f32,
+    /// Clear coat factor and roughness (its normal is the plane's); 0: none.
+    clearcoat: (f32, f32),
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Self {
+            base: Vec3::ONE,
+            metallic: 1.0,
+            roughness: 1.0,
+            occlusion: 1.0,
+            emissive: Vec3::ZERO,
+            unlit: false,
+            dielectric_f0: Vec3::splat(DIELECTRIC_F0),
+            specular_weight: 1.0,
+            clearcoat: (0.0, 0.0),
+        }
+    }
 }
 
 /// The rules' colour of the surface point `p` with normal `n`: shading (or the unlit colour)
 /// plus emission, exposure and the tone map.
 fn expected(lighting: &PbrLighting, params: &Params, n: Vec3, p: Vec3) -> Vec3 {
-    let lit = if params.unlit {
-        params.base
+    let rgb = if params.unlit {
+        params.base + params.emissive
     } else {
+        let (factor, roughness) = params.clearcoat;
         let surface = Surface::<Scalar> {
             base: splat3(params.base),
             metallic: Scalar.splat_f32(params.metallic),
@@ -193,10 +217,16 @@ fn expected(lighting: &PbrLighting, params: &Params, n: Vec3, p: Vec3) -> Vec3 {
             occlusion: Scalar.splat_f32(params.occlusion),
             normal: splat3(n),
             position: splat3(p),
+            dielectric_f0: splat3(params.dielectric_f0.min(Vec3::ONE)),
+            specular_weight: Scalar.splat_f32(params.specular_weight.clamp(0.0, 1.0)),
+            clearcoat: (factor > 0.0).then(|| ClearcoatLayer {
+                factor: Scalar.splat_f32(factor),
+                roughness: Scalar.splat_f32(roughness),
+                normal: splat3(plane_normal()),
+            }),
         };
-        lane0(shade(Scalar, lighting, &surface))
+        lane0(shade(Scalar, lighting, &surface, &splat3(params.emissive)))
     };
-    let rgb = lit + params.emissive;
     lane0(tonemap(
         Scalar,
         lighting.tonemap,
@@ -298,6 +328,7 @@ fn punctual_lights_follow_the_rules() {
                 occlusion: 1.0,
                 emissive: Vec3::new(0.02, 0.01, 0.0),
                 unlit: false,
+                ..Params::default()
             };
             let what = format!(
                 "metallic {metallic} roughness {roughness} {tonemap:?} EV {exposure} headlight {headlight}"
@@ -375,6 +406,7 @@ fn the_studio_environment_follows_the_rules() {
             occlusion: o,
             emissive: Vec3::ZERO,
             unlit: false,
+            ..Params::default()
         };
         let what = format!(
             "studio: metallic {metallic} roughness {roughness} occluded {occluded} textured {textured}"
@@ -422,6 +454,7 @@ fn normal_textures_follow_the_rules() {
         occlusion: 1.0,
         emissive: Vec3::ZERO,
         unlit: false,
+        ..Params::default()
     };
     // From the front, then from behind (the back face of a double-sided plane).
     let behind = Vec3::new(-0.4, -0.6, -2.5);
@@ -482,6 +515,7 @@ fn unlit_materials_are_tone_mapped() {
             occlusion: 1.0,
             emissive,
             unlit: true,
+            ..Params::default()
         };
         let what = format!("unlit {tonemap:?} EV {exposure}");
         let worst = check_scene(&mut gl, scene, EYE, &params, &what);
@@ -527,5 +561,92 @@ fn lambert_scenes_ignore_the_pbr_data() {
             // And it is lit: Lambert's ambient + diffuse, not black.
             assert!(a.color.iter().all(|c| c[0] > 0.0), "unlit pixels");
         }
+    }
+}
+
+/// `KHR_materials_ior`, `KHR_materials_specular` and `KHR_materials_clearcoat` — factors and
+/// textures (specular weight in alpha, an sRGB specular colour, coat weight in red, coat
+/// roughness in green) — under a punctual light and the studio, as the rules shade them.
+#[test]
+fn specular_ior_and_clear_coat_follow_the_rules() {
+    let Some(mut gl) = gl_or_skip() else {
+        return;
+    };
+    // Specular texel: alpha 0.6. Specular colour (sRGB): a warm tint. Coat: red 0.8; coat
+    // roughness: green 0.5.
+    let specular = [0u8, 0, 0, 153];
+    let specular_color = [255u8, 200, 120, 255];
+    let coat = [204u8, 0, 0, 255];
+    let coat_roughness = [0u8, 128, 0, 255];
+    let f0_of_ior = |ior: f64| (((ior - 1.0) / (ior + 1.0)).powi(2)) as f32;
+    let base = Vec3::new(0.3, 0.5, 0.8);
+    // (ior, specular colour factor, weight, coat factor, coat roughness, textured)
+    let cases = [
+        (1.5, Vec3::ONE, 1.0, 0.0, 0.0, false),
+        (2.0, Vec3::new(1.0, 0.5, 0.2), 0.7, 0.0, 0.0, false),
+        (1.33, Vec3::splat(2.0), 1.0, 0.0, 0.0, true),
+        (1.5, Vec3::ONE, 1.0, 1.0, 0.0, false),
+        (1.5, Vec3::ONE, 0.5, 0.7, 0.4, true),
+        (1.8, Vec3::new(0.8, 1.0, 1.0), 1.0, 1.0, 1.0, false),
+    ];
+    for (ior, color, weight, coat_factor, coat_rough, textured) in cases {
+        let mut material = Material {
+            base_color_factor: base.extend(1.0),
+            metallic: 0.2,
+            roughness: 0.35,
+            dielectric_f0: Vec3::splat(f0_of_ior(ior)) * color,
+            specular_weight: weight,
+            clearcoat: coat_factor,
+            clearcoat_roughness: coat_rough,
+            ..Material::default()
+        };
+        let mut params = Params {
+            base,
+            metallic: 0.2,
+            roughness: 0.35,
+            dielectric_f0: Vec3::splat(f0_of_ior(ior)) * color,
+            specular_weight: weight,
+            clearcoat: (coat_factor, coat_rough),
+            ..Params::default()
+        };
+        let mut textures = Vec::new();
+        if textured {
+            material.specular_texture = binding(textures.len());
+            textures.push(constant_texture(specular));
+            material.specular_color_texture = binding(textures.len());
+            let srgb = Texture::from_rgba8(2, 2, &specular_color.repeat(4), ColorSpace::Srgb)
+                .expect("texture");
+            let decoded = srgb.sample_lod(&Sampler::default(), Vec2::splat(0.5), 0.0);
+            textures.push(Arc::new(srgb));
+            params.specular_weight = weight * unorm(specular[3]);
+            params.dielectric_f0 *= decoded.truncate();
+            if coat_factor > 0.0 {
+                material.clearcoat_texture = binding(textures.len());
+                textures.push(constant_texture(coat));
+                material.clearcoat_roughness_texture = binding(textures.len());
+                textures.push(constant_texture(coat_roughness));
+                params.clearcoat = (
+                    (coat_factor * unorm(coat[0])).clamp(0.0, 1.0),
+                    (coat_rough * unorm(coat_roughness[1])).clamp(0.0, 1.0),
+                );
+            }
+        }
+        let mut scene = scene(
+            material,
+            textures,
+            vec![PunctualLight {
+                kind: LightKind::Directional,
+                color: Vec3::splat(0.8),
+                position: Vec3::ZERO,
+                direction: Vec3::new(1.0, -0.4, -0.2),
+                range: None,
+            }],
+        );
+        scene.environment = Some(EnvironmentLight::studio());
+        let what = format!(
+            "ior {ior} colour {color} weight {weight} coat {coat_factor}/{coat_rough} textured {textured}"
+        );
+        let worst = check_scene(&mut gl, scene, EYE, &params, &what);
+        eprintln!("{what}: largest difference {worst:.2e}");
     }
 }

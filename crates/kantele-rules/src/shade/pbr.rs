@@ -1,7 +1,9 @@
 //! glTF 2.0's physically based shading, written once for every backend: the metallic-roughness
 //! BRDF of the specification's Appendix B (GGX distribution, Smith height-correlated
-//! visibility, Schlick Fresnel, the metal / dielectric mix), the `KHR_lights_punctual` falloff,
-//! image-based light through an [`EnvironmentLight`], exposure and tone mapping.
+//! visibility, Schlick Fresnel, the metal / dielectric mix), with the dielectric reflectance of
+//! `KHR_materials_ior` and `KHR_materials_specular` and the coat of `KHR_materials_clearcoat`;
+//! the `KHR_lights_punctual` falloff, image-based light through an [`EnvironmentLight`],
+//! exposure and tone mapping.
 //!
 //! The functions are generic over [`Lanes`]: the CPU backend runs them on eight pixels at once,
 //! and on one pixel through the same code (a scalar [`Lanes`] with the value in every lane), so
@@ -140,6 +142,28 @@ pub struct Surface<L: Lanes> {
     pub normal: [L::F32; 3],
     /// The surface point.
     pub position: [L::F32; 3],
+    /// Reflectance at normal incidence of the dielectric part, in [0, 1]
+    /// ([`DIELECTRIC_F0`] without `KHR_materials_ior` and `KHR_materials_specular`).
+    pub dielectric_f0: [L::F32; 3],
+    /// Weight of the dielectric part's specular reflection (`KHR_materials_specular`; 1
+    /// without it).
+    pub specular_weight: L::F32,
+    /// The clear coat, where the material has one.
+    pub clearcoat: Option<ClearcoatLayer<L>>,
+}
+
+/// `KHR_materials_clearcoat`'s layer over a surface point, per lane: a dielectric (F0 =
+/// [`DIELECTRIC_F0`]) GGX lobe of its own roughness and normal, weighted by `factor`, which
+/// takes `factor × F_coat(N_coat·V)` of the light away from what lies under it (emission
+/// included).
+#[derive(Clone, Copy, Debug)]
+pub struct ClearcoatLayer<L: Lanes> {
+    /// `clearcoatFactor` × texture, in [0, 1].
+    pub factor: L::F32,
+    /// Perceptual roughness in [0, 1].
+    pub roughness: L::F32,
+    /// The coat's shading normal (unit).
+    pub normal: [L::F32; 3],
 }
 
 /// What lights a frame's PBR draws: the punctual lights, the environment and the eye.
@@ -221,24 +245,40 @@ fn clamp01<L: Lanes>(lanes: L, x: L::F32) -> L::F32 {
     x.max(lanes.splat_f32(0.0)).min(lanes.splat_f32(1.0))
 }
 
-/// The material's diffuse colour and reflectance at normal incidence: `c_diff = base × (1 −
-/// metallic)`, `F0 = 0.04 + (base − 0.04) × metallic`.
+/// The reflectance of a surface point: Schlick's `F0` and `F90` of the metal / dielectric
+/// mix, and the diffuse colour.
+#[derive(Clone, Copy)]
+struct Reflectance<L: Lanes> {
+    c_diff: [L::F32; 3],
+    f0: [L::F32; 3],
+    f90: L::F32,
+}
+
+/// The material's diffuse colour and reflectance: `c_diff = base × (1 − metallic)`,
+/// `F0 = w F0d + (base − w F0d) × metallic`, `F90 = w + (1 − w) × metallic`, where `F0d` is
+/// the dielectric reflectance and `w` the specular weight: the metal's Fresnel (`F0 = base`,
+/// `F90 = 1`) mixed with the dielectric's scaled by `w` (Schlick's form is affine in `F0` and
+/// `F90`). Without the extensions (`F0d = 0.04`, `w = 1`) this is Appendix B's
+/// `F0 = 0.04 + (base − 0.04) × metallic`, `F90 = 1`, to the bit.
 #[inline(always)]
-fn diffuse_and_f0<L: Lanes>(lanes: L, s: &Surface<L>) -> ([L::F32; 3], [L::F32; 3]) {
+fn reflectance<L: Lanes>(lanes: L, s: &Surface<L>) -> Reflectance<L> {
     let one = lanes.splat_f32(1.0);
-    let f0 = lanes.splat_f32(DIELECTRIC_F0);
     let dielectric = one - s.metallic;
     let c_diff = [
         s.base[0] * dielectric,
         s.base[1] * dielectric,
         s.base[2] * dielectric,
     ];
-    let f0 = [
-        f0 + (s.base[0] - f0) * s.metallic,
-        f0 + (s.base[1] - f0) * s.metallic,
-        f0 + (s.base[2] - f0) * s.metallic,
-    ];
-    (c_diff, f0)
+    let w = s.specular_weight;
+    let f0 = std::array::from_fn(|c| {
+        let weighted = s.dielectric_f0[c] * w;
+        weighted + (s.base[c] - weighted) * s.metallic
+    });
+    Reflectance {
+        c_diff,
+        f0,
+        f90: w + (one - w) * s.metallic,
+    }
 }
 
 /// `D × V`: the GGX distribution times the Smith height-correlated visibility, for
@@ -267,18 +307,30 @@ pub fn ggx_d_times_v<L: Lanes>(
     d * v
 }
 
-/// Schlick's Fresnel: `F0 + (1 − F0) (1 − VdotH)⁵`.
+/// Schlick's Fresnel: `F0 + (F90 − F0) (1 − VdotH)⁵`.
 #[inline(always)]
-pub fn schlick<L: Lanes>(lanes: L, f0: &[L::F32; 3], v_dot_h: L::F32) -> [L::F32; 3] {
-    let one = lanes.splat_f32(1.0);
-    let m = one - v_dot_h;
-    let m2 = m * m;
-    let m5 = m2 * m2 * m;
+pub fn schlick<L: Lanes>(lanes: L, f0: &[L::F32; 3], f90: L::F32, v_dot_h: L::F32) -> [L::F32; 3] {
+    let m5 = schlick_weight(lanes, v_dot_h);
     [
-        f0[0] + (one - f0[0]) * m5,
-        f0[1] + (one - f0[1]) * m5,
-        f0[2] + (one - f0[2]) * m5,
+        f0[0] + (f90 - f0[0]) * m5,
+        f0[1] + (f90 - f0[1]) * m5,
+        f0[2] + (f90 - f0[2]) * m5,
     ]
+}
+
+/// `(1 − VdotH)⁵`, Schlick's weight.
+#[inline(always)]
+fn schlick_weight<L: Lanes>(lanes: L, v_dot_h: L::F32) -> L::F32 {
+    let m = lanes.splat_f32(1.0) - v_dot_h;
+    let m2 = m * m;
+    m2 * m2 * m
+}
+
+/// The clear coat's Fresnel: Schlick's with `F0 = 0.04`, `F90 = 1`.
+#[inline(always)]
+fn coat_fresnel<L: Lanes>(lanes: L, v_dot_h: L::F32) -> L::F32 {
+    let f0 = lanes.splat_f32(DIELECTRIC_F0);
+    f0 + (lanes.splat_f32(1.0) - f0) * schlick_weight(lanes, v_dot_h)
 }
 
 /// Radiance arriving from `light` at the surface point and the unit vector towards it:
@@ -328,24 +380,25 @@ pub fn light_arrival<L: Lanes>(
 }
 
 /// Outgoing radiance of one surface point towards `view` (unit, towards the eye) lit by one
-/// punctual light: `radiance × NdotL × ((1 − F) c_diff / π + F D V)` (Appendix B).
+/// punctual light: `radiance × NdotL × ((1 − F) c_diff / π + F D V)` (Appendix B); and, with
+/// a clear coat, the coat's lobe `radiance × NdotL_coat × F_coat D V` (its roughness and
+/// normal; not yet weighted by the coat factor).
 #[inline(always)]
 fn punctual<L: Lanes>(
     lanes: L,
     light: &FrameLight,
     s: &Surface<L>,
     view: &[L::F32; 3],
-    c_diff: &[L::F32; 3],
-    f0: &[L::F32; 3],
+    r: &Reflectance<L>,
     alpha: L::F32,
-) -> [L::F32; 3] {
+) -> ([L::F32; 3], [L::F32; 3]) {
     let (l, attenuation) = light_arrival(lanes, light, &s.position);
     let h = normalize3(lanes, [view[0] + l[0], view[1] + l[1], view[2] + l[2]]);
     let n_dot_l = clamp01(lanes, dot3::<L>(&s.normal, &l));
     let n_dot_v = clamp01(lanes, dot3::<L>(&s.normal, view));
     let n_dot_h = clamp01(lanes, dot3::<L>(&s.normal, &h));
     let v_dot_h = clamp01(lanes, dot3::<L>(view, &h));
-    let f = schlick(lanes, f0, v_dot_h);
+    let f = schlick(lanes, &r.f0, r.f90, v_dot_h);
     let dv = ggx_d_times_v(lanes, alpha, n_dot_l, n_dot_v, n_dot_h);
     let one = lanes.splat_f32(1.0);
     let inv_pi = lanes.splat_f32(INV_PI);
@@ -353,18 +406,38 @@ fn punctual<L: Lanes>(
     let mut out = [lanes.splat_f32(0.0); 3];
     let color = light.color.to_array();
     for c in 0..3 {
-        let brdf = (one - f[c]) * c_diff[c] * inv_pi + f[c] * dv;
+        let brdf = (one - f[c]) * r.c_diff[c] * inv_pi + f[c] * dv;
         out[c] = lanes.splat_f32(color[c]) * scale * brdf;
     }
-    out
+    let mut coat = [lanes.splat_f32(0.0); 3];
+    if let Some(layer) = &s.clearcoat {
+        let n = &layer.normal;
+        let n_dot_l = clamp01(lanes, dot3::<L>(n, &l));
+        let n_dot_v = clamp01(lanes, dot3::<L>(n, view));
+        let n_dot_h = clamp01(lanes, dot3::<L>(n, &h));
+        let clamped = layer.roughness.max(lanes.splat_f32(MIN_PUNCTUAL_ROUGHNESS));
+        let dv = ggx_d_times_v(lanes, clamped * clamped, n_dot_l, n_dot_v, n_dot_h);
+        let lobe = attenuation * n_dot_l * coat_fresnel(lanes, v_dot_h) * dv;
+        for c in 0..3 {
+            coat[c] = lanes.splat_f32(color[c]) * lobe;
+        }
+    }
+    (out, coat)
 }
 
-/// The linear colour of a lit surface point, before exposure and tone mapping: every punctual
-/// light by Appendix B (`punctual`), plus image-based light (diffuse irradiance × `c_diff × (1 − FssEss)`
-/// and the pre-filtered specular radiance × `FssEss = F0 A + B`, both × occlusion), where `A`,
-/// `B` are the split-sum terms of the environment's BRDF table.
+/// The linear colour of a lit surface point emitting `emissive`, before exposure and tone
+/// mapping: every punctual light by Appendix B (`punctual`), plus image-based light (diffuse
+/// irradiance × `c_diff × (1 − FssEss)` and the pre-filtered specular radiance × `FssEss = F0 A
+/// + F90 B`, both × occlusion), where `A`, `B` are the split-sum terms of the environment's
+/// BRDF table; plus the emission. With a clear coat of weight `k` (`KHR_materials_clearcoat`)
+/// that sum is scaled by `1 − k F_coat(N_coat·V)` and the coat's own lobe, × `k`, is added.
 #[inline(always)]
-pub fn shade<L: Lanes>(lanes: L, lighting: &PbrLighting, s: &Surface<L>) -> [L::F32; 3] {
+pub fn shade<L: Lanes>(
+    lanes: L,
+    lighting: &PbrLighting,
+    s: &Surface<L>,
+    emissive: &[L::F32; 3],
+) -> [L::F32; 3] {
     let view = normalize3(
         lanes,
         [
@@ -373,58 +446,94 @@ pub fn shade<L: Lanes>(lanes: L, lighting: &PbrLighting, s: &Surface<L>) -> [L::
             lanes.splat_f32(lighting.eye.z) - s.position[2],
         ],
     );
-    let (c_diff, f0) = diffuse_and_f0(lanes, s);
+    let r = reflectance(lanes, s);
     let clamped = s.roughness.max(lanes.splat_f32(MIN_PUNCTUAL_ROUGHNESS));
     let alpha = clamped * clamped;
     let mut color = [lanes.splat_f32(0.0); 3];
+    let mut coat_color = [lanes.splat_f32(0.0); 3];
     for light in &lighting.lights {
-        let c = punctual(lanes, light, s, &view, &c_diff, &f0, alpha);
+        let (c, coat) = punctual(lanes, light, s, &view, &r, alpha);
         for k in 0..3 {
             color[k] = color[k] + c[k];
+            coat_color[k] = coat_color[k] + coat[k];
         }
     }
     if let Some(environment) = &lighting.environment {
-        let ibl = image_based(lanes, environment, s, &view, &c_diff, &f0);
+        let (ibl, coat_ibl) = image_based(lanes, environment, s, &view, &r);
         for k in 0..3 {
             color[k] = color[k] + ibl[k];
+            coat_color[k] = coat_color[k] + coat_ibl[k];
+        }
+    }
+    for k in 0..3 {
+        color[k] = color[k] + emissive[k];
+    }
+    if let Some(layer) = &s.clearcoat {
+        let n_dot_v = clamp01(lanes, dot3::<L>(&layer.normal, &view));
+        let under = lanes.splat_f32(1.0) - layer.factor * coat_fresnel(lanes, n_dot_v);
+        for k in 0..3 {
+            color[k] = color[k] * under + layer.factor * coat_color[k];
         }
     }
     color
 }
 
-/// The image-based part of [`shade`].
+/// The image-based part of [`shade`]: the light under the coat, and the coat's lobe (not yet
+/// weighted by the coat factor; 0 without a coat).
 #[inline(always)]
 fn image_based<L: Lanes>(
     lanes: L,
     environment: &EnvironmentLight,
     s: &Surface<L>,
     view: &[L::F32; 3],
-    c_diff: &[L::F32; 3],
-    f0: &[L::F32; 3],
-) -> [L::F32; 3] {
+    r: &Reflectance<L>,
+) -> ([L::F32; 3], [L::F32; 3]) {
     let one = lanes.splat_f32(1.0);
-    let n = &s.normal;
-    let n_dot_v_raw = dot3::<L>(n, view);
-    let n_dot_v = clamp01(lanes, n_dot_v_raw);
-    // R = 2 (N·V) N − V.
-    let two_n_dot_v = n_dot_v_raw + n_dot_v_raw;
-    let reflected = [
-        two_n_dot_v * n[0] - view[0],
-        two_n_dot_v * n[1] - view[1],
-        two_n_dot_v * n[2] - view[2],
+    let zero = lanes.splat_f32(0.0);
+    let coat = s.clearcoat.as_ref();
+    // The specular lookups of the base and of the coat, from one call site: each call site of
+    // the lookups is compiled into every kernel.
+    let lobes = [
+        (s.normal, s.roughness),
+        coat.map_or((s.normal, s.roughness), |layer| {
+            (layer.normal, layer.roughness)
+        }),
     ];
-    let irradiance = environment.irradiance_lanes(lanes, n);
-    let specular = environment.specular_lanes(lanes, &reflected, s.roughness);
-    let [a, b] = environment.brdf_lanes(lanes, n_dot_v, s.roughness);
+    let count = if coat.is_some() { 2 } else { 1 };
+    let mut reads = [([zero; 3], zero, zero); 2];
+    for ((n, roughness), read) in lobes[..count].iter().zip(&mut reads) {
+        let n_dot_v_raw = dot3::<L>(n, view);
+        let n_dot_v = clamp01(lanes, n_dot_v_raw);
+        // R = 2 (N·V) N − V.
+        let two_n_dot_v = n_dot_v_raw + n_dot_v_raw;
+        let reflected = [
+            two_n_dot_v * n[0] - view[0],
+            two_n_dot_v * n[1] - view[1],
+            two_n_dot_v * n[2] - view[2],
+        ];
+        let specular = environment.specular_lanes(lanes, &reflected, *roughness);
+        let [a, b] = environment.brdf_lanes(lanes, n_dot_v, *roughness);
+        *read = (specular, a, b);
+    }
+    let irradiance = environment.irradiance_lanes(lanes, &s.normal);
     let intensity = lanes.splat_f32(environment.intensity);
     let weight = s.occlusion * intensity;
-    let mut out = [lanes.splat_f32(0.0); 3];
+    let (specular, a, b) = reads[0];
+    let mut out = [zero; 3];
     for c in 0..3 {
-        let fss_ess = f0[c] * a + b;
-        let diffuse = irradiance[c] * c_diff[c] * (one - fss_ess);
+        let fss_ess = r.f0[c] * a + r.f90 * b;
+        let diffuse = irradiance[c] * r.c_diff[c] * (one - fss_ess);
         out[c] = (diffuse + specular[c] * fss_ess) * weight;
     }
-    out
+    let mut coat_out = [zero; 3];
+    if coat.is_some() {
+        let (specular, a, b) = reads[1];
+        let fss_ess = lanes.splat_f32(DIELECTRIC_F0) * a + b;
+        for c in 0..3 {
+            coat_out[c] = specular[c] * fss_ess * weight;
+        }
+    }
+    (out, coat_out)
 }
 
 /// Exposure (`× scale`) and the tone map, per lane.

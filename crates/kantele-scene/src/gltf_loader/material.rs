@@ -27,7 +27,7 @@ pub(super) struct UvMap {
 impl UvMap {
     /// The map of a texture reference: its `texCoord` and its `KHR_texture_transform`
     /// extension value, if any.
-    fn of(tex_coord: u32, texture_transform: Option<&serde_json::Value>) -> Self {
+    pub(super) fn of(tex_coord: u32, texture_transform: Option<&serde_json::Value>) -> Self {
         let mut set = tex_coord;
         let mut transform = Mat3::IDENTITY;
         if let Some(t) = texture_transform {
@@ -67,30 +67,43 @@ impl UvMap {
 
 /// Which of a material's textures.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum TextureSlot {
+pub(super) enum TextureSlot {
     BaseColor,
     Emissive,
     MetallicRoughness,
     Normal,
     Occlusion,
+    Specular,
+    SpecularColor,
+    Clearcoat,
+    ClearcoatRoughness,
+    ClearcoatNormal,
 }
 
 impl TextureSlot {
-    fn name(self) -> &'static str {
+    pub(super) fn name(self) -> &'static str {
         match self {
             TextureSlot::BaseColor => "base colour",
             TextureSlot::Emissive => "emissive",
             TextureSlot::MetallicRoughness => "metallic-roughness",
             TextureSlot::Normal => "normal",
             TextureSlot::Occlusion => "occlusion",
+            TextureSlot::Specular => "specular",
+            TextureSlot::SpecularColor => "specular colour",
+            TextureSlot::Clearcoat => "clear coat",
+            TextureSlot::ClearcoatRoughness => "clear-coat roughness",
+            TextureSlot::ClearcoatNormal => "clear-coat normal",
         }
     }
 }
 
-impl Loader<'_> {
+impl<'a> Loader<'a> {
     /// Converts a material; also records which texture coordinates its textures read
     /// (`self.material_uv`), which the loader bakes into the meshes that use it.
-    pub(super) fn material(&mut self, material: &gltf::Material) -> Result<Material, LoadError> {
+    pub(super) fn material(
+        &mut self,
+        material: &gltf::Material<'a>,
+    ) -> Result<Material, LoadError> {
         let name = named(material.name(), "material", material.index().unwrap_or(0));
         let pbr = material.pbr_metallic_roughness();
         let transform = "KHR_texture_transform";
@@ -121,6 +134,8 @@ impl Loader<'_> {
             let uv = UvMap::of(t.tex_coord(), t.extension_value(transform));
             refs.push((TextureSlot::Occlusion, t.texture(), ColorSpace::Linear, uv));
         }
+        let extensions = self.material_extensions(material, &name);
+        refs.extend(extensions.textures.iter().cloned());
         let strength = material
             .extension_value("KHR_materials_emissive_strength")
             .and_then(|v| v.get("emissiveStrength"))
@@ -146,6 +161,11 @@ impl Loader<'_> {
             occlusion_strength: material
                 .occlusion_texture()
                 .map_or(1.0, |t| finite_or(t.strength(), 1.0).clamp(0.0, 1.0)),
+            dielectric_f0: extensions.dielectric_f0,
+            specular_weight: extensions.specular_weight,
+            clearcoat: extensions.clearcoat,
+            clearcoat_roughness: extensions.clearcoat_roughness,
+            clearcoat_normal_scale: extensions.clearcoat_normal_scale,
             ..Material::default()
         };
         // The meshes carry one set of texture coordinates per material: the first texture's
@@ -179,6 +199,11 @@ impl Loader<'_> {
                 TextureSlot::MetallicRoughness => out.metallic_roughness_texture = binding,
                 TextureSlot::Normal => out.normal_texture = binding,
                 TextureSlot::Occlusion => out.occlusion_texture = binding,
+                TextureSlot::Specular => out.specular_texture = binding,
+                TextureSlot::SpecularColor => out.specular_color_texture = binding,
+                TextureSlot::Clearcoat => out.clearcoat_texture = binding,
+                TextureSlot::ClearcoatRoughness => out.clearcoat_roughness_texture = binding,
+                TextureSlot::ClearcoatNormal => out.clearcoat_normal_texture = binding,
             }
         }
         self.material_uv.push(first.map(|(map, _)| map));

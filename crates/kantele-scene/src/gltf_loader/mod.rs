@@ -2,6 +2,7 @@
 
 mod camera;
 mod material;
+mod material_extensions;
 mod nodes;
 mod primitive;
 
@@ -25,6 +26,9 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_mesh_quantization",
     "KHR_texture_transform",
     "KHR_materials_emissive_strength",
+    "KHR_materials_ior",
+    "KHR_materials_specular",
+    "KHR_materials_clearcoat",
     "EXT_mesh_gpu_instancing",
     "EXT_texture_webp",
     "EXT_meshopt_compression",
