@@ -603,7 +603,9 @@ impl Shader for PbrShader<'_> {
         ShadedLanes { color, keep }
     }
 
-    /// [`PbrProgram`]: `fragment_lanes` with no kernels of its own for constant triangles.
+    /// Runs `job` with `fragment_lanes` as a lane program that has no kernels of its own for
+    /// constant triangles (a PBR triangle reads its world position, never the same at three
+    /// vertices).
     #[inline(always)]
     fn with_lane_program<J: LaneProgramJob>(&self, job: J) -> J::Output {
         job.run(&PbrProgram(self))

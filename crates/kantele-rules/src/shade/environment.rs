@@ -171,7 +171,7 @@ impl EnvironmentLight {
     /// Pre-filtered specular radiance along `r` (need not be unit) at `roughness`, per lane:
     /// bilinear in the two levels around `roughness × (SPECULAR_LEVELS − 1)`, linear between
     /// them (intensity not applied). Every lane reads its own levels, by gathers from the
-    /// environment's texels ([`Environment::texel_bits`]).
+    /// environment's texels (all levels in one table of `f32` bits).
     #[inline(always)]
     pub fn specular_lanes<L: Lanes>(
         &self,
