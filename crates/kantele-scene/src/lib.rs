@@ -54,6 +54,7 @@ mod obj_wide;
 mod quiet_panic;
 mod read_policy;
 mod shading;
+mod spec_gloss_texels;
 pub mod texture_util;
 mod uri;
 

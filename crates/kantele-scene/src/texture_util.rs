@@ -5,7 +5,7 @@ use kantele_rules::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Text
 use crate::budget::Budget;
 
 /// Bytes of memory a decoded texture keeps per texel: `f32` RGBA plus its mip chain (4/3).
-const TEXTURE_BYTES_PER_TEXEL: u64 = 16 * 4 / 3 + 1;
+pub(crate) const TEXTURE_BYTES_PER_TEXEL: u64 = 16 * 4 / 3 + 1;
 
 /// Why an image did not become a texture.
 #[derive(Debug)]

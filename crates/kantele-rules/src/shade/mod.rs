@@ -1,8 +1,10 @@
-//! Shading resources: textures, their 8-bit texel format and the samplers that read them.
+//! Shading resources: textures, their 8-bit texel format and the samplers that read them; the
+//! PBR rules and the specular-glossiness conversion.
 pub mod environment;
 mod levels;
 pub mod pbr;
 pub mod sample_lanes;
+pub mod spec_gloss;
 pub mod texel;
 mod texel_lanes;
 pub mod texture;

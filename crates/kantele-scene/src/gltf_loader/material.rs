@@ -7,6 +7,7 @@ use glam::{Mat3, Vec2, Vec3, Vec4};
 use kantele_rules::scene::{AlphaMode, Material, TextureBinding};
 use kantele_rules::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 
+use super::spec_gloss::SPEC_GLOSS;
 use super::{named, Loader};
 use crate::accessor::BufferData;
 use crate::texture_util::{decode_within, image_size, placeholder, ImageError};
@@ -97,6 +98,35 @@ impl TextureSlot {
     }
 }
 
+/// A glTF image read by [`Loader::read_image`].
+enum ReadImage {
+    /// Identical encoded bytes were loaded before, as this scene texture.
+    Loaded(usize),
+    /// Newly decoded (a placeholder when textures are not decoded), with its encoded bytes
+    /// (the key of `encoded_images`) and its size.
+    Decoded {
+        texture: Box<Texture>,
+        encoded: Vec<u8>,
+        size: (u32, u32),
+    },
+}
+
+/// A decoded image to read texels from ([`Loader::source_image`]).
+pub(super) struct SourceImage {
+    /// The texture (shared with the scene when the scene has it).
+    pub(super) texture: Arc<Texture>,
+    /// Its size (that of the image when textures are not decoded).
+    pub(super) size: (u32, u32),
+}
+
+/// Where a material's texture comes from.
+enum TextureSource<'a> {
+    /// A texture of the file, decoded in a colour space.
+    File(gltf::texture::Texture<'a>, ColorSpace),
+    /// A texture the loader made (`KHR_materials_pbrSpecularGlossiness`).
+    Made(TextureBinding),
+}
+
 impl<'a> Loader<'a> {
     /// Converts a material; also records which texture coordinates its textures read
     /// (`self.material_uv`), which the loader bakes into the meshes that use it.
@@ -106,36 +136,74 @@ impl<'a> Loader<'a> {
     ) -> Result<Material, LoadError> {
         let name = named(material.name(), "material", material.index().unwrap_or(0));
         let pbr = material.pbr_metallic_roughness();
+        // KHR_materials_pbrSpecularGlossiness replaces pbrMetallicRoughness (then a fallback
+        // for viewers without the extension), as in the viewers that support it.
+        let spec_gloss = match material.extension_value(SPEC_GLOSS) {
+            Some(extension) if extension.is_object() => Some(self.spec_gloss(&name, extension)?),
+            Some(_) => {
+                self.info.warn(format!(
+                    "material '{name}': {SPEC_GLOSS} is not an object; its metallic-roughness values are used"
+                ));
+                None
+            }
+            None => None,
+        };
         let transform = "KHR_texture_transform";
-        // Every texture of the material, with its colour space and the coordinates it reads.
-        let mut refs: Vec<(TextureSlot, gltf::texture::Texture, ColorSpace, UvMap)> = Vec::new();
-        if let Some(info) = pbr.base_color_texture() {
-            let uv = UvMap::of(info.tex_coord(), info.extension_value(transform));
-            refs.push((TextureSlot::BaseColor, info.texture(), ColorSpace::Srgb, uv));
+        // Every texture of the material, with where it comes from and the coordinates it reads.
+        let mut refs: Vec<(TextureSlot, TextureSource, UvMap)> = Vec::new();
+        let file = TextureSource::File;
+        match &spec_gloss {
+            Some(converted) => {
+                if let Some(t) = converted.textures {
+                    let made = TextureSource::Made(t.base_color);
+                    refs.push((TextureSlot::BaseColor, made, t.uv));
+                }
+            }
+            None => {
+                if let Some(info) = pbr.base_color_texture() {
+                    let uv = UvMap::of(info.tex_coord(), info.extension_value(transform));
+                    let source = file(info.texture(), ColorSpace::Srgb);
+                    refs.push((TextureSlot::BaseColor, source, uv));
+                }
+            }
         }
         if let Some(info) = material.emissive_texture() {
             let uv = UvMap::of(info.tex_coord(), info.extension_value(transform));
-            refs.push((TextureSlot::Emissive, info.texture(), ColorSpace::Srgb, uv));
+            let source = file(info.texture(), ColorSpace::Srgb);
+            refs.push((TextureSlot::Emissive, source, uv));
         }
-        if let Some(info) = pbr.metallic_roughness_texture() {
-            let uv = UvMap::of(info.tex_coord(), info.extension_value(transform));
-            refs.push((
-                TextureSlot::MetallicRoughness,
-                info.texture(),
-                ColorSpace::Linear,
-                uv,
-            ));
+        match &spec_gloss {
+            Some(converted) => {
+                if let Some(t) = converted.textures {
+                    let made = TextureSource::Made(t.metallic_roughness);
+                    refs.push((TextureSlot::MetallicRoughness, made, t.uv));
+                }
+            }
+            None => {
+                if let Some(info) = pbr.metallic_roughness_texture() {
+                    let uv = UvMap::of(info.tex_coord(), info.extension_value(transform));
+                    let source = file(info.texture(), ColorSpace::Linear);
+                    refs.push((TextureSlot::MetallicRoughness, source, uv));
+                }
+            }
         }
         if let Some(t) = material.normal_texture() {
             let uv = UvMap::of(t.tex_coord(), t.extension_value(transform));
-            refs.push((TextureSlot::Normal, t.texture(), ColorSpace::Linear, uv));
+            refs.push((
+                TextureSlot::Normal,
+                file(t.texture(), ColorSpace::Linear),
+                uv,
+            ));
         }
         if let Some(t) = material.occlusion_texture() {
             let uv = UvMap::of(t.tex_coord(), t.extension_value(transform));
-            refs.push((TextureSlot::Occlusion, t.texture(), ColorSpace::Linear, uv));
+            let source = file(t.texture(), ColorSpace::Linear);
+            refs.push((TextureSlot::Occlusion, source, uv));
         }
         let extensions = self.material_extensions(material, &name);
-        refs.extend(extensions.textures.iter().cloned());
+        for (slot, texture, color_space, uv) in &extensions.textures {
+            refs.push((*slot, file(texture.clone(), *color_space), *uv));
+        }
         let strength = material
             .extension_value("KHR_materials_emissive_strength")
             .and_then(|v| v.get("emissiveStrength"))
@@ -168,10 +236,15 @@ impl<'a> Loader<'a> {
             clearcoat_normal_scale: extensions.clearcoat_normal_scale,
             ..Material::default()
         };
+        if let Some(converted) = spec_gloss {
+            out.base_color_factor = converted.base_color_factor;
+            out.metallic = converted.metallic;
+            out.roughness = converted.roughness;
+        }
         // The meshes carry one set of texture coordinates per material: the first texture's
         // (the base colour's when it has one). A texture reading other coordinates is left out.
         let mut first: Option<(UvMap, TextureSlot)> = None;
-        for (slot, texture, color_space, map) in refs {
+        for (slot, source, map) in refs {
             if material.unlit() && slot != TextureSlot::BaseColor {
                 // KHR_materials_unlit: every property but the base colour is a fallback for
                 // viewers without the extension.
@@ -192,7 +265,12 @@ impl<'a> Loader<'a> {
                 }
                 Some(_) => {}
             }
-            let binding = self.texture_binding(&texture, color_space)?;
+            let binding = match source {
+                TextureSource::File(texture, color_space) => {
+                    self.texture_binding(&texture, color_space)?
+                }
+                TextureSource::Made(binding) => Some(binding),
+            };
             match slot {
                 TextureSlot::BaseColor => out.base_color_texture = binding,
                 TextureSlot::Emissive => out.emissive_texture = binding,
@@ -246,39 +324,48 @@ impl<'a> Loader<'a> {
         let Some(texture_index) = texture_index else {
             return Ok(None);
         };
-        let s = texture.sampler();
-        let wrap = |mode| match mode {
-            gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
-            gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
-            gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
-        };
-        let sampler = Sampler {
-            wrap_s: wrap(s.wrap_s()),
-            wrap_t: wrap(s.wrap_t()),
-            mag_filter: match s.mag_filter() {
-                Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
-                Some(gltf::texture::MagFilter::Linear) | None => Filter::Linear,
-            },
-            min_filter: match s.min_filter() {
-                Some(gltf::texture::MinFilter::Nearest) => MinFilter::Nearest,
-                Some(gltf::texture::MinFilter::Linear) => MinFilter::Linear,
-                Some(gltf::texture::MinFilter::NearestMipmapNearest) => {
-                    MinFilter::NearestMipmapNearest
-                }
-                Some(gltf::texture::MinFilter::LinearMipmapNearest) => {
-                    MinFilter::LinearMipmapNearest
-                }
-                Some(gltf::texture::MinFilter::NearestMipmapLinear) => {
-                    MinFilter::NearestMipmapLinear
-                }
-                Some(gltf::texture::MinFilter::LinearMipmapLinear) | None => {
-                    MinFilter::LinearMipmapLinear
-                }
-            },
-        };
         Ok(Some(TextureBinding {
             texture: texture_index,
-            sampler,
+            sampler: sampler_of(texture),
+        }))
+    }
+
+    /// The decoded image of `texture` in `color_space`, with its size, for reading texels: the
+    /// scene's texture when the image is loaded in that colour space, otherwise decoded here
+    /// (charged to the budget) without adding it to the scene. `None` when the texture has no
+    /// image or it cannot be loaded and the load is not strict (a warning says so).
+    pub(super) fn source_image(
+        &mut self,
+        texture: &gltf::texture::Texture,
+        color_space: ColorSpace,
+    ) -> Result<Option<SourceImage>, LoadError> {
+        let Some(image_index) = self
+            .patched
+            .texture_images
+            .get(texture.index())
+            .copied()
+            .flatten()
+        else {
+            return Ok(None);
+        };
+        let loaded = match self.image_textures.get(&(image_index, color_space)) {
+            Some(&loaded) => loaded,
+            None => match self.read_image(image_index, color_space)? {
+                None => None,
+                Some(ReadImage::Loaded(t)) => Some(t),
+                Some(ReadImage::Decoded { texture, size, .. }) => {
+                    return Ok(Some(SourceImage {
+                        texture: Arc::from(texture),
+                        size,
+                    }))
+                }
+            },
+        };
+        Ok(loaded.and_then(|t| {
+            Some(SourceImage {
+                texture: self.scene.textures.get(t)?.clone(),
+                size: *self.info.texture_sizes.get(t)?,
+            })
         }))
     }
 
@@ -286,6 +373,30 @@ impl<'a> Loader<'a> {
     /// encoded image and colour space); `None` when it is missing or cannot be decoded and the
     /// load is not strict (a warning says so). Budget overruns are always errors.
     fn image(&mut self, index: usize, color_space: ColorSpace) -> Result<Option<usize>, LoadError> {
+        Ok(match self.read_image(index, color_space)? {
+            None => None,
+            Some(ReadImage::Loaded(t)) => Some(t),
+            Some(ReadImage::Decoded {
+                texture,
+                encoded,
+                size,
+            }) => {
+                let t = self.push_texture(*texture, size);
+                self.encoded_images.insert((encoded, color_space), t);
+                Some(t)
+            }
+        })
+    }
+
+    /// Reads and decodes one glTF image as a texture of `color_space`, or finds it among the
+    /// scene's textures when identical encoded bytes were loaded before; `None` when it is
+    /// missing or cannot be decoded and the load is not strict (a warning says so). Budget
+    /// overruns are always errors.
+    fn read_image(
+        &mut self,
+        index: usize,
+        color_space: ColorSpace,
+    ) -> Result<Option<ReadImage>, LoadError> {
         let Some(image) = self.document.images().nth(index) else {
             return Ok(None);
         };
@@ -319,7 +430,7 @@ impl<'a> Loader<'a> {
         };
         let key = (bytes, color_space);
         if let Some(&t) = self.encoded_images.get(&key) {
-            return Ok(Some(t));
+            return Ok(Some(ReadImage::Loaded(t)));
         }
         let bytes = key.0;
         let size = match image_size(&bytes, mime_type.as_deref()) {
@@ -330,35 +441,33 @@ impl<'a> Loader<'a> {
         };
         if !self.options.decode_textures {
             // Describing the scene: the header's size is reported, nothing is decoded.
-            return Ok(Some(self.push_texture(
-                placeholder(),
-                (bytes, color_space),
+            return Ok(Some(ReadImage::Decoded {
+                texture: Box::new(placeholder()),
+                encoded: bytes,
                 size,
-            )));
+            }));
         }
         match decode_within(&bytes, mime_type.as_deref(), color_space, &mut self.budget) {
-            Ok(texture) => Ok(Some(self.push_texture(texture, (bytes, color_space), size))),
+            Ok(texture) => Ok(Some(ReadImage::Decoded {
+                texture: Box::new(texture),
+                encoded: bytes,
+                size,
+            })),
             Err(ImageError::Budget(e)) => Err(self.invalid(format!("{what}: {e}"))),
             Err(ImageError::Decode(e)) => self.texture_problem(format!("{what}: {e}")),
         }
     }
 
-    fn push_texture(
-        &mut self,
-        texture: Texture,
-        encoded: (Vec<u8>, ColorSpace),
-        size: (u32, u32),
-    ) -> usize {
+    /// Adds a texture to the scene, with the size `kantele info` reports; its index.
+    pub(super) fn push_texture(&mut self, texture: Texture, size: (u32, u32)) -> usize {
         self.scene.textures.push(Arc::new(texture));
         self.info.texture_sizes.push(size);
-        let t = self.scene.textures.len() - 1;
-        self.encoded_images.insert(encoded, t);
-        t
+        self.scene.textures.len() - 1
     }
 
     /// A texture that cannot be loaded: an error when strict, otherwise a warning and no
     /// texture.
-    fn texture_problem(&mut self, message: String) -> Result<Option<usize>, LoadError> {
+    pub(super) fn texture_problem<T>(&mut self, message: String) -> Result<Option<T>, LoadError> {
         if self.options.strict {
             return Err(self.invalid(message));
         }
@@ -373,5 +482,34 @@ impl<'a> Loader<'a> {
             self.scene.materials.push(Material::default());
             self.scene.materials.len() - 1
         })
+    }
+}
+
+/// The sampler of a glTF texture (glTF's defaults where the file gives none: REPEAT, bilinear
+/// magnification, trilinear minification).
+pub(super) fn sampler_of(texture: &gltf::texture::Texture) -> Sampler {
+    let s = texture.sampler();
+    let wrap = |mode| match mode {
+        gltf::texture::WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        gltf::texture::WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        gltf::texture::WrappingMode::Repeat => Wrap::Repeat,
+    };
+    Sampler {
+        wrap_s: wrap(s.wrap_s()),
+        wrap_t: wrap(s.wrap_t()),
+        mag_filter: match s.mag_filter() {
+            Some(gltf::texture::MagFilter::Nearest) => Filter::Nearest,
+            Some(gltf::texture::MagFilter::Linear) | None => Filter::Linear,
+        },
+        min_filter: match s.min_filter() {
+            Some(gltf::texture::MinFilter::Nearest) => MinFilter::Nearest,
+            Some(gltf::texture::MinFilter::Linear) => MinFilter::Linear,
+            Some(gltf::texture::MinFilter::NearestMipmapNearest) => MinFilter::NearestMipmapNearest,
+            Some(gltf::texture::MinFilter::LinearMipmapNearest) => MinFilter::LinearMipmapNearest,
+            Some(gltf::texture::MinFilter::NearestMipmapLinear) => MinFilter::NearestMipmapLinear,
+            Some(gltf::texture::MinFilter::LinearMipmapLinear) | None => {
+                MinFilter::LinearMipmapLinear
+            }
+        },
     }
 }

@@ -5,6 +5,7 @@ mod material;
 mod material_extensions;
 mod nodes;
 mod primitive;
+mod spec_gloss;
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -29,6 +30,7 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_clearcoat",
+    "KHR_materials_pbrSpecularGlossiness",
     "EXT_mesh_gpu_instancing",
     "EXT_texture_webp",
     "EXT_meshopt_compression",
@@ -98,6 +100,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         info,
         image_textures: HashMap::new(),
         encoded_images: HashMap::new(),
+        spec_gloss_textures: HashMap::new(),
         primitive_meshes: HashMap::new(),
         default_material: None,
         material_uv: Vec::new(),
@@ -242,6 +245,9 @@ struct Loader<'a> {
     image_textures: HashMap<(usize, ColorSpace), Option<usize>>,
     /// Encoded image bytes → index into `scene.textures`: identical sources decode once.
     encoded_images: HashMap<(Vec<u8>, ColorSpace), usize>,
+    /// `KHR_materials_pbrSpecularGlossiness` conversions → their base colour and
+    /// metallic-roughness textures in `scene.textures` (`None`: no source could be loaded).
+    spec_gloss_textures: HashMap<spec_gloss::ConversionKey, Option<(usize, usize)>>,
     /// (glTF mesh, primitive, morph weights' bits) → index into `scene.meshes` (`None`: not
     /// drawable, skipped).
     primitive_meshes: HashMap<(usize, usize, Vec<u32>), Option<usize>>,

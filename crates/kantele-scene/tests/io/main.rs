@@ -16,5 +16,6 @@ mod hostile_files;
 mod isa_identical;
 mod obj_files;
 mod reference_scenes;
+mod spec_gloss;
 mod srgb8_target;
 mod valid_files;
