@@ -1,5 +1,5 @@
-"""Kantele: a software rasterizer. Load glTF 2.0 / OBJ files or numpy meshes and render colour,
-depth, normals and ids into numpy arrays on the CPU.
+"""Kantele: a software rasterizer. Load glTF 2.0 / OBJ / PLY / STL files or numpy meshes and
+render colour, depth, normals and ids into numpy arrays on the CPU.
 
 >>> import kantele
 >>> scene = kantele.load("bunny.glb")

@@ -27,12 +27,12 @@ def load(
     exposure: float = 0.0,
     tonemap: Tonemap = "pbr-neutral",
 ) -> Scene:
-    """Loads a glTF 2.0 (`.gltf`, `.glb`) or OBJ file. `FileNotFoundError`/`OSError` when it
-    cannot be read, `ValueError` when it is malformed. `shading`: `auto` (glTF reference
-    scenes and OBJ files Lambert, other glTF files PBR), `lambert` or `pbr`; for PBR,
-    `environment` (`"studio"`, `"none"` or an .hdr / .exr file; default: the studio when the
-    file has no lights), `environment_intensity`, `environment_rotation` (degrees about +Y),
-    `exposure` (stops) and `tonemap`, as the `kantele` command's options."""
+    """Loads a glTF 2.0 (`.gltf`, `.glb`), OBJ, PLY or STL file. `FileNotFoundError`/`OSError`
+    when it cannot be read, `ValueError` when it is malformed. `shading`: `auto` (glTF reference
+    scenes and OBJ, PLY and STL files Lambert, other glTF files PBR), `lambert` or `pbr`; for
+    PBR, `environment` (`"studio"`, `"none"` or an .hdr / .exr file; default: the studio when
+    the file has no lights), `environment_intensity`, `environment_rotation` (degrees about
+    +Y), `exposure` (stops) and `tonemap`, as the `kantele` command's options."""
 
 def write_png(path: PathLike, image: npt.NDArray[np.uint8]) -> None:
     """Writes a `uint8` (H, W, 4) or (H, W, 3) image, row 0 at the top, as PNG."""

@@ -20,7 +20,7 @@ use pyo3::prelude::*;
 use camera::PyCamera;
 use scene::PyScene;
 
-/// Loads a glTF 2.0 (`.gltf`, `.glb`) or OBJ file into a `Scene` (the arguments as
+/// Loads a glTF 2.0 (`.gltf`, `.glb`), OBJ, PLY or STL file into a `Scene` (the arguments as
 /// `Scene.load`'s).
 #[pyfunction]
 #[pyo3(signature = (path, shading = "auto", environment = None, environment_intensity = 1.0, environment_rotation = 0.0, exposure = 0.0, tonemap = "pbr-neutral"))]

@@ -50,7 +50,7 @@ impl PyScene {
         })
     }
 
-    /// Loads a scene file (glTF or OBJ) under `options` with the GIL released.
+    /// Loads a scene file (glTF, OBJ, PLY or STL) under `options` with the GIL released.
     pub fn load_path(py: Python<'_>, path: PathBuf, options: LoadOptions) -> PyResult<Self> {
         let loaded = py
             .detach(|| kantele_scene::load_scene_with(&path, &options))
@@ -330,12 +330,12 @@ fn prefix(source: &str, error: RenderError) -> RenderError {
 
 #[pymethods]
 impl PyScene {
-    /// Loads a glTF 2.0 (`.gltf`, `.glb`) or OBJ file. Raises `OSError` when the file cannot be
-    /// read and `ValueError` when it is malformed. `shading`: `auto` (glTF reference scenes
-    /// and OBJ files Lambert, other glTF files PBR), `lambert` or `pbr`; for PBR,
-    /// `environment` (`studio`, `none` or an .hdr / .exr file; default: the studio when the
-    /// file has no lights), `environment_intensity`, `environment_rotation` (degrees about
-    /// +Y), `exposure` (stops) and `tonemap` (`none`, `pbr-neutral`, `aces`), as the
+    /// Loads a glTF 2.0 (`.gltf`, `.glb`), OBJ, PLY or STL file. Raises `OSError` when the file
+    /// cannot be read and `ValueError` when it is malformed. `shading`: `auto` (glTF reference
+    /// scenes and OBJ, PLY and STL files Lambert, other glTF files PBR), `lambert` or `pbr`;
+    /// for PBR, `environment` (`studio`, `none` or an .hdr / .exr file; default: the studio
+    /// when the file has no lights), `environment_intensity`, `environment_rotation` (degrees
+    /// about +Y), `exposure` (stops) and `tonemap` (`none`, `pbr-neutral`, `aces`), as the
     /// `kantele` command's options of the same names.
     #[staticmethod]
     #[pyo3(signature = (path, shading = "auto", environment = None, environment_intensity = 1.0, environment_rotation = 0.0, exposure = 0.0, tonemap = "pbr-neutral"))]

@@ -7,8 +7,8 @@ use kantele::multisample::SampleCount;
 use kantele::raster::Strategy;
 use kantele::rop::TargetFormat;
 
-/// Kantele: a software rasterizer. Render, inspect, benchmark, compare and view glTF 2.0 / OBJ
-/// scenes by Kantele's rendering rules (`docs/rendering-rules.md`).
+/// Kantele: a software rasterizer. Render, inspect, benchmark, compare and view glTF 2.0, OBJ,
+/// PLY and STL scenes by Kantele's rendering rules (`docs/rendering-rules.md`).
 ///
 /// Errors are reported as one line `kantele: error: <file>: <problem>` on stderr with exit
 /// status 2 (`compare` exits with 1 when a tolerance is broken).
@@ -59,7 +59,8 @@ pub struct ThumbnailArgs {
 /// Which scenes to work on: files and built-in scenes.
 #[derive(Debug, Args, Clone)]
 pub struct SceneArgs {
-    /// Scene files (.gltf, .glb, .obj), folders of them, or quoted patterns ("scans/*.glb").
+    /// Scene files (.gltf, .glb, .obj, .ply, .stl), folders of them, or quoted patterns
+    /// ("scans/*.glb").
     #[arg(value_name = "SCENE")]
     pub scenes: Vec<PathBuf>,
     /// A built-in scene (cube, teapot, ground, pixel-edges, pbr-spheres, pbr-lights); may be repeated. Built-ins come after the files.
@@ -77,8 +78,8 @@ pub struct SceneArgs {
     #[arg(long = "allow-read", value_name = "DIR")]
     pub allow_read: Vec<PathBuf>,
     /// Shading model of scene files: `auto` lets the file decide (glTF reference scenes, whose
-    /// extras carry `ambient`, and OBJ files are drawn with `lambert`; every other glTF file
-    /// with `pbr`, glTF's metallic-roughness model). Built-in scenes keep their own.
+    /// extras carry `ambient`, and OBJ, PLY and STL files are drawn with `lambert`; every other
+    /// glTF file with `pbr`, glTF's metallic-roughness model). Built-in scenes keep their own.
     #[arg(long, value_enum, default_value_t = ShadingArg::Auto)]
     pub shading: ShadingArg,
     /// Image-based light of PBR scenes: `studio` (built-in), `none`, or an equirectangular

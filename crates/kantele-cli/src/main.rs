@@ -1,8 +1,8 @@
 //! The `kantele` command: render, inspect, benchmark, compare and view scenes.
 //!
-//! Scenes are glTF 2.0 / OBJ files (loaded by `kantele-scene`) or built-ins (`--builtin cube`),
-//! drawn by the rules of the reference scenes. Backends are `cpu` (Kantele) and `gl` (the
-//! OpenGL reference, `kantele-gl`).
+//! Scenes are glTF 2.0 / OBJ / PLY / STL files (loaded by `kantele-scene`) or built-ins
+//! (`--builtin cube`), drawn by the rules of the reference scenes. Backends are `cpu` (Kantele)
+//! and `gl` (the OpenGL reference, `kantele-gl`).
 //!
 //! - `render` writes PNG/EXR colour and, optionally, depth (PFM/EXR), normal and id images,
 //!   plus a JSON sidecar ([`render_cmd`]).

@@ -73,7 +73,7 @@ impl Input {
 }
 
 /// Extensions of scene files found in folders and by patterns.
-pub const SCENE_EXTENSIONS: &[&str] = &["gltf", "glb", "obj"];
+pub const SCENE_EXTENSIONS: &[&str] = &["gltf", "glb", "obj", "ply", "stl"];
 
 fn is_scene_file(path: &Path) -> bool {
     path.is_file() && SCENE_EXTENSIONS.contains(&crate::output::extension(path).as_str())
@@ -90,7 +90,7 @@ fn folder_scenes(dir: &Path) -> Result<Vec<PathBuf>> {
     found.sort();
     if found.is_empty() {
         bail!(
-            "{}: the folder holds no scene files (.gltf, .glb, .obj)",
+            "{}: the folder holds no scene files (.gltf, .glb, .obj, .ply, .stl)",
             dir.display()
         );
     }
@@ -106,7 +106,7 @@ fn pattern_scenes(pattern: &str) -> Result<Vec<PathBuf>> {
         .collect();
     found.sort();
     if found.is_empty() {
-        bail!("{pattern}: no scene file (.gltf, .glb, .obj) matches");
+        bail!("{pattern}: no scene file (.gltf, .glb, .obj, .ply, .stl) matches");
     }
     Ok(found)
 }

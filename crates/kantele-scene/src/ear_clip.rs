@@ -1,7 +1,9 @@
-//! Triangulating polygons (OBJ faces with more than three corners) by ear clipping, so that
-//! concave faces keep their shape (a fan would cover area outside them).
+//! Triangulating polygons (OBJ and PLY faces with more than three corners) by ear clipping, so
+//! that concave faces keep their shape (a fan would cover area outside them).
 
 use glam::{Vec2, Vec3};
+
+use crate::budget::Budget;
 
 /// Polygons with more corners than this are fan-split instead (ear clipping is quadratic).
 pub(crate) const MAX_EAR_CLIP_CORNERS: usize = 4096;
@@ -88,6 +90,52 @@ pub(crate) fn triangulate(corners: &[Vec3]) -> Option<Vec<[usize; 3]>> {
     }
     triangles.push([remaining[0], remaining[1], remaining[2]]);
     Some(triangles)
+}
+
+/// Triangles of the faces (`arities` corners each; empty means all triangles): polygons by ear
+/// clipping, so concave ones keep their shape; faces of one or two corners are dropped. The
+/// indices must be in range for `positions`.
+pub(crate) fn triangulate_faces(
+    indices: &[u32],
+    arities: &[u32],
+    positions: &[Vec3],
+    budget: &mut Budget,
+) -> Result<Vec<u32>, String> {
+    if arities.is_empty() {
+        if indices.len() % 3 != 0 {
+            return Err("the faces do not make whole triangles".to_string());
+        }
+        return Ok(indices.to_vec());
+    }
+    let corners: u64 = arities.iter().map(|&a| a as u64).sum();
+    if corners != indices.len() as u64 {
+        return Err("the face sizes do not match the indices".to_string());
+    }
+    // A polygon of k corners makes k − 2 triangles: at most 3 indices per corner.
+    budget.charge(corners, 12, "triangulating the faces")?;
+    let mut out = crate::budget::vec_with_capacity(indices.len() * 3, "triangulating the faces")?;
+    let mut start = 0;
+    for &arity in arities {
+        let face = &indices[start..start + arity as usize];
+        start += arity as usize;
+        if face.len() < 3 {
+            continue;
+        }
+        let corners: Vec<Vec3> = face.iter().map(|&i| positions[i as usize]).collect();
+        match triangulate(&corners) {
+            Some(triangles) => {
+                for t in triangles {
+                    out.extend(t.iter().map(|&k| face[k]));
+                }
+            }
+            None => {
+                for k in 1..face.len() - 1 {
+                    out.extend([face[0], face[k], face[k + 1]]);
+                }
+            }
+        }
+    }
+    Ok(out)
 }
 
 #[cfg(test)]

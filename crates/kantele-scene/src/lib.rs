@@ -1,9 +1,9 @@
-//! Scene loading for Kantele: glTF 2.0 (`.gltf`, `.glb`) and OBJ/MTL files into a
+//! Scene loading for Kantele: glTF 2.0 (`.gltf`, `.glb`), OBJ/MTL, PLY and STL files into a
 //! [`kantele_rules::scene::Scene`], by the rules of the reference scenes, plus built-in demo scenes.
 //!
 //! The rules (draw order, camera, light, extras, materials) are those of
-//! `docs/rendering-rules.md`; the glTF loader follows them exactly, the OBJ loader and the
-//! built-in scenes fill the same structure with sensible defaults.
+//! `docs/rendering-rules.md`; the glTF loader follows them exactly, the OBJ, PLY and STL loaders
+//! and the built-in scenes fill the same structure with sensible defaults.
 //!
 //! # Entry points
 //!
@@ -51,10 +51,13 @@ mod meshopt_views;
 mod obj_loader;
 mod obj_text;
 mod obj_wide;
+mod ply_loader;
 mod quiet_panic;
 mod read_policy;
 mod shading;
+mod single_mesh;
 mod spec_gloss_texels;
+mod stl_loader;
 pub mod texture_util;
 mod uri;
 
@@ -142,7 +145,7 @@ pub enum LoadError {
         /// The I/O error.
         source: std::io::Error,
     },
-    /// The file is not valid glTF / OBJ, or uses something that cannot be drawn.
+    /// The file is not valid glTF / OBJ / PLY / STL, or uses something that cannot be drawn.
     #[error("{path}: {message}")]
     Invalid {
         /// The file.
@@ -151,7 +154,7 @@ pub enum LoadError {
         message: String,
     },
     /// The file extension is not one we read.
-    #[error("{path}: unknown scene format (expected .gltf, .glb or .obj)")]
+    #[error("{path}: unknown scene format (expected .gltf, .glb, .obj, .ply or .stl)")]
     UnknownFormat {
         /// The file.
         path: PathBuf,
@@ -169,6 +172,27 @@ impl LoadError {
             message: message.into(),
         }
     }
+}
+
+/// A parser's message as one line for a [`LoadError`]: line breaks, tabs and other control
+/// characters become spaces, runs of spaces one, and a long message is cut at 200 characters.
+pub(crate) fn one_line(message: &str) -> String {
+    const MAX_CHARS: usize = 200;
+    let mut out = String::new();
+    for (count, word) in message
+        .split(|c: char| c.is_whitespace() || c.is_control())
+        .filter(|w| !w.is_empty())
+        .enumerate()
+    {
+        if count > 0 {
+            out.push(' ');
+        }
+        out.push_str(word);
+    }
+    if out.chars().count() > MAX_CHARS {
+        out = out.chars().take(MAX_CHARS).collect::<String>() + "…";
+    }
+    out
 }
 
 /// Default memory budget of a load: 4 GiB.
@@ -193,7 +217,7 @@ pub struct LoadOptions {
     /// its size stands in for it: for describing a scene without paying for its pixels.
     pub decode_textures: bool,
     /// The shading model; `None` (default) lets the file decide: glTF reference scenes (whose
-    /// `scene.extras` carry `ambient`), OBJ files and built-in scenes are drawn with
+    /// `scene.extras` carry `ambient`), OBJ, PLY and STL files and built-in scenes are drawn with
     /// [`Shading::Lambert`], every other glTF file with [`Shading::Pbr`].
     pub shading: Option<Shading>,
     /// Image-based light of PBR scenes.
@@ -240,7 +264,7 @@ impl Default for LoadOptions {
 }
 
 /// Loads a scene file with the default [`LoadOptions`], choosing the format by extension
-/// (`.gltf`, `.glb`, `.obj`).
+/// (`.gltf`, `.glb`, `.obj`, `.ply`, `.stl`; any case).
 ///
 /// Malformed input of any kind gives an error naming the file; the loader does not panic.
 pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadError> {
@@ -260,6 +284,8 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
         match extension.as_deref() {
             Some("gltf") | Some("glb") => gltf_loader::load,
             Some("obj") => obj_loader::load,
+            Some("ply") => ply_loader::load,
+            Some("stl") => stl_loader::load,
             _ => {
                 return Err(LoadError::UnknownFormat {
                     path: path.to_path_buf(),
@@ -294,4 +320,20 @@ fn builtin_names() -> Vec<&'static str> {
 /// Builds a built-in scene by name.
 pub fn builtin_scene(name: &str) -> Result<LoadedScene, LoadError> {
     builtin::build(name).ok_or_else(|| LoadError::UnknownBuiltin(name.to_string()))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parser_messages_become_one_short_line() {
+        assert_eq!(
+            one_line("Couldn't read element line.\n\tString: '1 2\r\n'\n\tError: x"),
+            "Couldn't read element line. String: '1 2 ' Error: x"
+        );
+        let long = one_line(&"word ".repeat(100));
+        assert_eq!(long.chars().count(), 201);
+        assert!(long.ends_with('…'));
+    }
 }

@@ -12,7 +12,7 @@ use kantele_rules::scene::{
 use kantele_rules::shade::texture::Texture;
 
 use crate::budget::Budget;
-use crate::ear_clip::triangulate;
+use crate::ear_clip::triangulate_faces;
 use crate::mesh_util::{first_index_out_of_range, flat_normals, framing_camera};
 use crate::obj_text::{patch_mtl, patch_obj, text, texture_file_name, UNNAMED_MATERIAL};
 use crate::obj_wide::{read_lines_points, ObjWide};
@@ -378,49 +378,4 @@ fn load_texture(
         return Ok((placeholder(), size));
     }
     Ok((decode_srgb_within(&bytes, None, budget)?, size))
-}
-
-/// Triangles of the faces (`arities` corners each; empty means all triangles): polygons by ear
-/// clipping, so concave ones keep their shape; faces of one or two corners are dropped.
-fn triangulate_faces(
-    indices: &[u32],
-    arities: &[u32],
-    positions: &[Vec3],
-    budget: &mut Budget,
-) -> Result<Vec<u32>, String> {
-    if arities.is_empty() {
-        if indices.len() % 3 != 0 {
-            return Err("the faces do not make whole triangles".to_string());
-        }
-        return Ok(indices.to_vec());
-    }
-    let corners: u64 = arities.iter().map(|&a| a as u64).sum();
-    if corners != indices.len() as u64 {
-        return Err("the face sizes do not match the indices".to_string());
-    }
-    // A polygon of k corners makes k − 2 triangles: at most 3 indices per corner.
-    budget.charge(corners, 12, "triangulating the faces")?;
-    let mut out = crate::budget::vec_with_capacity(indices.len() * 3, "triangulating the faces")?;
-    let mut start = 0;
-    for &arity in arities {
-        let face = &indices[start..start + arity as usize];
-        start += arity as usize;
-        if face.len() < 3 {
-            continue;
-        }
-        let corners: Vec<Vec3> = face.iter().map(|&i| positions[i as usize]).collect();
-        match triangulate(&corners) {
-            Some(triangles) => {
-                for t in triangles {
-                    out.extend(t.iter().map(|&k| face[k]));
-                }
-            }
-            None => {
-                for k in 1..face.len() - 1 {
-                    out.extend([face[0], face[k], face[k + 1]]);
-                }
-            }
-        }
-    }
-    Ok(out)
 }

@@ -1,5 +1,5 @@
-//! Bodies of the `gltf` and `obj` fuzz targets (`fuzz/` at the repository root), as plain
-//! functions so that a stable test can replay the corpus without a nightly toolchain.
+//! Bodies of the `gltf`, `obj`, `ply` and `stl` fuzz targets (`fuzz/` at the repository root),
+//! as plain functions so that a stable test can replay the corpus without a nightly toolchain.
 //!
 //! Each loads the fuzzer's bytes as a scene file in a private, otherwise empty folder (the read
 //! policy confines the scene to it) under a 64 MiB budget, and renders what loads at 32 × 32
@@ -52,6 +52,25 @@ pub fn obj(data: &[u8]) {
     let scene = folder.join("scene.obj");
     std::fs::write(&scene, obj).expect("write the fuzz input");
     std::fs::write(folder.join("scene.mtl"), mtl).expect("write the fuzz input");
+    let result = load(&scene);
+    check_and_render(result);
+}
+
+/// The `ply` target: the bytes as `scene.ply`.
+pub fn ply(data: &[u8]) {
+    load_and_render_as(data, "scene.ply");
+}
+
+/// The `stl` target: the bytes as `scene.stl`.
+pub fn stl(data: &[u8]) {
+    load_and_render_as(data, "scene.stl");
+}
+
+/// Writes the bytes as the file `name` in a fresh folder, loads it and renders what loads.
+fn load_and_render_as(data: &[u8], name: &str) {
+    let folder = fresh_folder();
+    let scene = folder.join(name);
+    std::fs::write(&scene, data).expect("write the fuzz input");
     let result = load(&scene);
     check_and_render(result);
 }

@@ -36,14 +36,14 @@ import numpy as np
 
 import kantele
 
-SCENE_SUFFIXES = (".glb", ".gltf", ".obj")
+SCENE_SUFFIXES = (".glb", ".gltf", ".obj", ".ply", ".stl")
 
 
 def find_scenes(paths: Iterable[str]) -> List[str]:
     """Scene files named by ``paths``: files as given, directories searched recursively for
-    ``.glb``, ``.gltf`` and ``.obj`` files (sorted). Raises ``FileNotFoundError`` for a missing
-    path and ``ValueError`` when nothing is found or two scenes share a file stem (their
-    outputs would collide)."""
+    ``.glb``, ``.gltf``, ``.obj``, ``.ply`` and ``.stl`` files (sorted). Raises
+    ``FileNotFoundError`` for a missing path and ``ValueError`` when nothing is found or two
+    scenes share a file stem (their outputs would collide)."""
     found: List[str] = []
     for p in paths:
         path = Path(p)
@@ -56,7 +56,7 @@ def find_scenes(paths: Iterable[str]) -> List[str]:
         else:
             raise FileNotFoundError(f"{p}: no such file or directory")
     if not found:
-        raise ValueError("no scene files (.glb, .gltf, .obj) found")
+        raise ValueError("no scene files (.glb, .gltf, .obj, .ply, .stl) found")
     stems: Dict[str, str] = {}
     for f in found:
         stem = Path(f).stem

@@ -1,10 +1,13 @@
-//! Helpers for the integration tests: temporary directories and a small glTF writer.
+//! Helpers for the integration tests: temporary directories, a small glTF writer and PLY and
+//! STL writers.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicUsize, Ordering};
 
 use serde_json::{json, Value};
+
+pub mod ply_stl;
 
 /// A fresh, empty temporary directory for one test.
 pub fn temp_dir(name: &str) -> PathBuf {

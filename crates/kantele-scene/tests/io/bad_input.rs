@@ -332,3 +332,137 @@ fn broken_obj_files() {
     let err = expect_texture_problem(&path, "nothere.png");
     assert!(err.contains("tex.obj"));
 }
+
+/// Loads `bytes` written as `name`, expecting a one-line error that names the file and
+/// contains `expected`.
+fn expect_one_line_error(dir: &Path, name: &str, bytes: &[u8], expected: &str) -> String {
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    let err = expect_error(&path, expected);
+    assert!(!err.contains('\n'), "not one line: {err}");
+    err
+}
+
+#[test]
+fn broken_ply_files() {
+    use crate::common::ply_stl::{quad_and_pentagon, PlyFormat, PlyMesh};
+    let dir = temp_dir("badply");
+    expect_one_line_error(&dir, "empty.ply", b"", "not a valid PLY file");
+    expect_one_line_error(
+        &dir,
+        "notply.ply",
+        b"solid x\nendsolid x\n",
+        "not a valid PLY file",
+    );
+    // Truncated binary files: inside the vertices (the header's counts no longer fit) and
+    // one byte short in the last face.
+    for format in [PlyFormat::BinaryLittleEndian, PlyFormat::BinaryBigEndian] {
+        let whole = quad_and_pentagon().to_ply(format);
+        let header = whole
+            .windows(11)
+            .position(|w| w == b"end_header\n")
+            .unwrap()
+            + 11;
+        let err =
+            expect_one_line_error(&dir, "cut-vertices.ply", &whole[..header + 40], "truncated");
+        assert!(err.contains("'vertex'"), "{err}");
+        let err =
+            expect_one_line_error(&dir, "cut-face.ply", &whole[..whole.len() - 1], "truncated");
+        assert!(err.contains("face 1 of 2"), "{err}");
+    }
+    // Indices out of range and negative ones.
+    let mut mesh = PlyMesh {
+        positions: vec![[0.0; 3], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        faces: Some(vec![vec![0, 1, 2], vec![0, 2, 9]]),
+        ..PlyMesh::default()
+    };
+    for format in PlyFormat::ALL {
+        let err = expect_one_line_error(&dir, "range.ply", &mesh.to_ply(format), "out of range");
+        assert!(err.contains("face 1") && err.contains("index 9"), "{err}");
+    }
+    mesh.faces = Some(vec![vec![0, -1, 2]]);
+    expect_one_line_error(
+        &dir,
+        "negative.ply",
+        &mesh.to_ply(PlyFormat::Ascii),
+        "negative",
+    );
+    // Text that is not UTF-8, in the data and in the header.
+    let mut ascii = mesh.to_ply(PlyFormat::Ascii);
+    let data = ascii
+        .windows(11)
+        .position(|w| w == b"end_header\n")
+        .unwrap()
+        + 11;
+    ascii[data] = 0xff;
+    expect_one_line_error(&dir, "latin1-data.ply", &ascii, "vertex 0 of 3");
+    let mut header = mesh.to_ply(PlyFormat::Ascii);
+    header[25] = 0xe9;
+    expect_one_line_error(&dir, "latin1-header.ply", &header, "not a valid PLY file");
+    // Numbers that are not numbers, and a short ASCII line.
+    let text = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n\
+                property float z\nend_header\n0 0 zero\n1 1\n";
+    expect_one_line_error(&dir, "words.ply", text.as_bytes(), "vertex 0 of 2");
+    // Vertices without a position; faces whose corners are not integers.
+    let text = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+                end_header\n0 0\n";
+    expect_one_line_error(&dir, "no-z.ply", text.as_bytes(), "no x, y and z");
+    let text = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n\
+                property float z\nelement face 1\nproperty list uchar float vertex_indices\n\
+                end_header\n0 0 0\n3 0 0 0\n";
+    expect_one_line_error(&dir, "float-faces.ply", text.as_bytes(), "not integers");
+}
+
+#[test]
+fn broken_stl_files() {
+    use crate::common::ply_stl::{stl_ascii, stl_binary, tetrahedron};
+    let dir = temp_dir("badstl");
+    let triangles = tetrahedron();
+    expect_one_line_error(&dir, "empty.stl", b"", "not an STL file");
+    expect_one_line_error(&dir, "short.stl", b"hello", "not an STL file");
+    // Binary: one byte short, and a header that declares 2^32 − 1 triangles.
+    let binary = stl_binary(&triangles, b"cut", [0.0; 3]);
+    let err = expect_one_line_error(&dir, "cut.stl", &binary[..binary.len() - 1], "truncated");
+    assert!(err.contains("4 triangles"), "{err}");
+    let mut huge = binary.clone();
+    huge[80..84].copy_from_slice(&u32::MAX.to_le_bytes());
+    expect_one_line_error(&dir, "huge.stl", &huge, "4294967295 triangles");
+    // ASCII: no `endsolid`, a facet cut short, text outside the solid, a NaN corner.
+    let ascii = stl_ascii(&triangles, "solid t", "\n");
+    let text = String::from_utf8(ascii.clone()).unwrap();
+    let no_end = text.replace("endsolid\n", "");
+    expect_one_line_error(&dir, "no-end.stl", no_end.as_bytes(), "truncated");
+    let cut = text.replacen("      vertex 1 0 0\n", "", 1);
+    expect_one_line_error(&dir, "short-facet.stl", cut.as_bytes(), "triangle 0");
+    let outside = format!("{text}trailing words\n");
+    expect_one_line_error(&dir, "outside.stl", outside.as_bytes(), "outside 'solid");
+    let nan = text.replacen("vertex 1 0 0", "vertex nan 0 0", 1);
+    expect_one_line_error(&dir, "nan.stl", nan.as_bytes(), "triangle 0");
+    let mut latin1 = ascii.clone();
+    let at = latin1.windows(6).position(|w| w == b"vertex").unwrap();
+    latin1[at] = 0xe9;
+    expect_one_line_error(&dir, "latin1.stl", &latin1, "triangle 0");
+}
+
+#[test]
+fn garbage_ply_and_stl() {
+    let dir = temp_dir("garbage-ply-stl");
+    let mut state = 0x9e37_79b9u32;
+    let bytes: Vec<u8> = (0..4096)
+        .map(|_| {
+            state ^= state << 13;
+            state ^= state >> 17;
+            state ^= state << 5;
+            state as u8
+        })
+        .collect();
+    expect_one_line_error(&dir, "garbage.ply", &bytes, "");
+    expect_one_line_error(&dir, "garbage.stl", &bytes, "");
+    // A PLY header followed by garbage.
+    let mut ply = b"ply\nformat binary_big_endian 1.0\nelement vertex 100\nproperty double x\n\
+        property double y\nproperty double z\nelement face 50\n\
+        property list uint uint vertex_indices\nend_header\n"
+        .to_vec();
+    ply.extend_from_slice(&bytes);
+    expect_one_line_error(&dir, "header-garbage.ply", &ply, "");
+}

@@ -533,6 +533,44 @@ fn realworld_files_render_with_their_properties() {
     );
 }
 
+#[test]
+fn realworld_ply_and_stl_files_render() {
+    let Some(dir) = realworld() else { return };
+    // Scans and CAD exports (`ply-stl/`): drawn with the Lambert rule, light grey and
+    // double-sided, framed by the made-up camera.
+    let meshes = [
+        "ply-stl/bunny.ply",
+        "ply-stl/cube_blender_uv.ply",
+        "ply-stl/20mm-xyz-cube.stl",
+        "ply-stl/cylinder.stl",
+        "ply-stl/featuretype.STL",
+    ];
+    for file in meshes {
+        let loaded = load_as_chosen(&dir.join(file));
+        assert_eq!(
+            loaded.scene.shading,
+            kantele::scene::Shading::Lambert,
+            "{file}"
+        );
+        let image = render(&loaded.scene, Pass::Color);
+        let share = coverage(&image) as f32 / (SIZE.0 * SIZE.1) as f32;
+        assert!(share > 0.05, "{file}: only {share} of the picture covered");
+        // Lit, not black: the headlight reaches what the camera sees, front or back.
+        let brightest = image
+            .color
+            .iter()
+            .zip(&image.depth)
+            .filter(|(_, d)| **d < 1.0)
+            .map(|(c, _)| c[0])
+            .fold(0.0f32, f32::max);
+        assert!(brightest > 0.3, "{file}: brightest {brightest}");
+    }
+    // The point cloud: its 8 points, one pixel each.
+    let loaded = load_as_chosen(&dir.join("ply-stl/ply_points_bin.ply"));
+    let drawn = coverage(&render(&loaded.scene, Pass::Color));
+    assert!((1..=8).contains(&drawn), "{drawn} pixels");
+}
+
 /// Renders the scene as the CLI does (`kantele_output::pose`: pixels square, the image's aspect
 /// wins) with its file camera at [`SIZE`].
 fn render_posed(scene: &Scene) -> FrameImage {

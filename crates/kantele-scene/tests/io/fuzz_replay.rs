@@ -164,6 +164,24 @@ fn obj_corpus_and_mutations() {
 }
 
 #[test]
+fn ply_corpus_and_mutations() {
+    replay(
+        "ply",
+        0x2545_f491_4f6c_dd1d,
+        kantele_testkit::fuzz_targets::ply,
+    );
+}
+
+#[test]
+fn stl_corpus_and_mutations() {
+    replay(
+        "stl",
+        0xbf58_476d_1ce4_e5b9,
+        kantele_testkit::fuzz_targets::stl,
+    );
+}
+
+#[test]
 fn raster_corpus_and_mutations() {
     replay(
         "raster",
@@ -193,6 +211,19 @@ fn write_seed_corpus() {
     std::fs::create_dir_all(&obj).expect("corpus dir");
     std::fs::write(obj.join("seed-builtin-cube.obj"), cube_obj()).expect("write");
     std::fs::write(obj.join("seed-polygons.obj"), polygons_obj()).expect("write");
+
+    // ply: the quad and pentagon in each encoding, and a point cloud; stl: a tetrahedron as
+    // ASCII and as binary with a `solid` header.
+    let ply = corpus_dir("ply");
+    std::fs::create_dir_all(&ply).expect("corpus dir");
+    for (name, bytes) in crate::common::ply_stl::ply_fuzz_seeds() {
+        std::fs::write(ply.join(name), bytes).expect("write");
+    }
+    let stl = corpus_dir("stl");
+    std::fs::create_dir_all(&stl).expect("corpus dir");
+    for (name, bytes) in crate::common::ply_stl::stl_fuzz_seeds() {
+        std::fs::write(stl.join(name), bytes).expect("write");
+    }
 
     // raster: width/height exponents, mode, strategy, then six little-endian u32 coordinates.
     let raster = corpus_dir("raster");

@@ -262,3 +262,101 @@ fn obj_texture_reads_are_confined_too() {
         1
     );
 }
+
+#[test]
+fn ply_and_stl_counts_beyond_the_file_are_refused_before_allocating() {
+    let dir = temp_dir("ply-stl-counts");
+    // 2^32 vertices of 12 bytes (48 GiB of data) declared, 12 bytes present.
+    let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 4294967296\n\
+        property float x\nproperty float y\nproperty float z\nend_header\n"
+        .to_vec();
+    ply.extend([0; 12]);
+    let path = dir.join("vertices.ply");
+    std::fs::write(&path, &ply).unwrap();
+    let started = std::time::Instant::now();
+    let err = load_scene(&path).expect_err("must be refused").to_string();
+    assert!(
+        err.contains("vertices.ply") && err.contains("4294967296 'vertex' elements"),
+        "{err}"
+    );
+    assert!(started.elapsed().as_secs() < 2, "{:?}", started.elapsed());
+    // Under a 1 GiB address-space cap the child must report the error, not abort.
+    let (ok, text) = load_in_capped_child(&path, 1024);
+    assert!(ok, "child failed: {text}");
+    assert!(text.contains("CHILD: error:"), "{text}");
+    // ASCII: 10^15 faces (and an element with no properties, which takes no bytes in binary
+    // but a line each in ASCII).
+    let text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n\
+        property float z\nelement face 1000000000000000\nproperty list uchar int vertex_indices\n\
+        end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    let path = dir.join("faces.ply");
+    std::fs::write(&path, text).unwrap();
+    let err = load_scene(&path).expect_err("must be refused").to_string();
+    assert!(err.contains("1000000000000000 'face' elements"), "{err}");
+    let empty_element = "ply\nformat binary_big_endian 1.0\nelement nothing 18446744073709551615\n\
+        end_header\n";
+    let path = dir.join("nothing.ply");
+    std::fs::write(&path, empty_element).unwrap();
+    let err = load_scene(&path).expect_err("must be refused").to_string();
+    assert!(err.contains("'nothing' elements"), "{err}");
+    // A face whose list declares 2^32 − 1 corners reads only what is there.
+    let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+        property float y\nproperty float z\nelement face 1\nproperty list uint int vertex_indices\n\
+        end_header\n"
+        .to_vec();
+    ply.extend([0; 36]);
+    ply.extend(u32::MAX.to_le_bytes());
+    ply.extend([0; 12]);
+    let path = dir.join("corners.ply");
+    std::fs::write(&path, &ply).unwrap();
+    let err = load_scene(&path).expect_err("must be refused").to_string();
+    assert!(err.contains("truncated"), "{err}");
+    let (ok, text) = load_in_capped_child(&path, 1024);
+    assert!(ok && text.contains("CHILD: error:"), "{text}");
+}
+
+#[test]
+fn ply_and_stl_arrays_are_charged_to_the_budget() {
+    let dir = temp_dir("ply-stl-budget");
+    let small = LoadOptions {
+        max_memory: 1 << 20,
+        ..LoadOptions::default()
+    };
+    // 100 000 vertices of three bytes each (300 KB): 1.2 MB of positions.
+    let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 100000\n\
+        property uchar x\nproperty uchar y\nproperty uchar z\nend_header\n"
+        .to_vec();
+    ply.extend((0..300_000).map(|i| (i % 251) as u8));
+    let path = dir.join("cloud.ply");
+    std::fs::write(&path, &ply).unwrap();
+    let err = load_scene_with(&path, &small)
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        err.contains("the vertices") && err.contains("memory budget"),
+        "{err}"
+    );
+    // The same file within a budget that fits: a point cloud of 100 000 points.
+    let loaded = load_scene(&path).expect("loads");
+    assert_eq!(loaded.scene.meshes[0].primitive_count(), 100_000);
+    // 20 000 binary STL triangles (1 MB): 1.7 MB of mesh.
+    let triangles = vec![[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]; 20_000];
+    let stl = crate::common::ply_stl::stl_binary(&triangles, b"many", [0.0; 3]);
+    let path = dir.join("many.stl");
+    std::fs::write(&path, &stl).unwrap();
+    let two = LoadOptions {
+        max_memory: 2 << 20,
+        ..LoadOptions::default()
+    };
+    let err = load_scene_with(&path, &two)
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        err.contains("the triangles") && err.contains("memory budget"),
+        "{err}"
+    );
+    assert_eq!(
+        load_scene(&path).expect("loads").scene.triangle_count(),
+        20_000
+    );
+}

@@ -1,5 +1,6 @@
-//! Integration tests of `kantele-scene`: glTF and OBJ loading (valid, bad and hostile files, the
-//! real-world corpus), fuzz replay, poses, the reference scenes and ISA-identical pictures.
+//! Integration tests of `kantele-scene`: glTF, OBJ, PLY and STL loading (valid, bad and hostile
+//! files, the real-world corpus), fuzz replay, poses, the reference scenes and ISA-identical
+//! pictures.
 //!
 //! One test binary with a module per subject: a binary per file would compile the shared
 //! generic code and link every dependency into each (in a clean build, 31 test binaries took a
@@ -15,6 +16,7 @@ mod gltf_files;
 mod hostile_files;
 mod isa_identical;
 mod obj_files;
+mod ply_stl_files;
 mod reference_scenes;
 mod spec_gloss;
 mod srgb8_target;
