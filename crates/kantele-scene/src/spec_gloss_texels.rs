@@ -127,8 +127,9 @@ pub(crate) fn convert_textures(
     })
 }
 
-/// Reads one source at the converted textures' texels (see the module documentation).
-struct Reader<'a> {
+/// Reads one source at the converted textures' texels (see the module documentation); the
+/// OBJ loader's combined textures (`mtl_texels`) read their sources the same way.
+pub(crate) struct Reader<'a> {
     source: Option<Source<'a>>,
     /// The source has the converted size: read its texels directly.
     same_size: bool,
@@ -137,7 +138,8 @@ struct Reader<'a> {
 }
 
 impl<'a> Reader<'a> {
-    fn new(source: Option<Source<'a>>, width: u32, height: u32) -> Self {
+    /// A reader of `source` for converted textures of `width` × `height` texels.
+    pub(crate) fn new(source: Option<Source<'a>>, width: u32, height: u32) -> Self {
         let same_size =
             source.is_some_and(|s| (s.texture.width(), s.texture.height()) == (width, height));
         Self {
@@ -155,7 +157,7 @@ impl<'a> Reader<'a> {
     }
 
     /// The linear RGBA of converted texel (`x`, `y`); white without a source.
-    fn texel(&self, x: u32, y: u32) -> Vec4 {
+    pub(crate) fn texel(&self, x: u32, y: u32) -> Vec4 {
         let Some(source) = self.source else {
             return Vec4::ONE;
         };
