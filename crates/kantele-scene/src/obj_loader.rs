@@ -44,7 +44,10 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     let source = text(&bytes);
     drop(bytes);
     let patched = patch_obj(&source);
-    let wide = (patched.lines + patched.points > 0).then(|| read_lines_points(&source));
+    // A file of vertices alone is drawn as points.
+    let vertices_only = patched.faces == 0 && patched.lines == 0 && patched.points == 0;
+    let wide = (patched.lines + patched.points > 0 || (vertices_only && patched.vertices > 0))
+        .then(|| read_lines_points(&source, vertices_only));
     drop(source);
     let policy = ReadPolicy::new(path, &options.allow_read);
     let directory = path.parent().unwrap_or(Path::new("")).to_path_buf();
@@ -303,8 +306,9 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     Ok(LoadedScene { scene, info })
 }
 
-/// Adds a mesh and a draw for each group of `l` / `p` statements, with only the positions it
-/// uses; its material is the `usemtl` in force (by name), else the default one.
+/// Adds a mesh and a draw for each group of `l` / `p` statements (or of the vertices of a file
+/// of vertices alone), with only the positions (and colours) it uses; its material is the
+/// `usemtl` in force (by name, the last of that name as in `tobj`), else the default one.
 fn add_lines_points(
     scene: &mut Scene,
     info: &mut SceneInfo,
@@ -319,7 +323,7 @@ fn add_lines_points(
         let named = group.material.as_ref().and_then(|name| {
             materials
                 .iter()
-                .position(|m| &m.name == name)
+                .rposition(|m| &m.name == name)
                 .filter(|&i| i < scene.materials.len())
         });
         let material = named.unwrap_or_else(|| {
@@ -329,21 +333,28 @@ fn add_lines_points(
             })
         });
         let mut remap: HashMap<u32, u32> = HashMap::new();
-        let mut positions = Vec::new();
+        let mut used = Vec::new();
         let indices = group
             .indices
             .iter()
             .map(|&i| {
                 *remap.entry(i).or_insert_with(|| {
-                    positions.push(wide.positions[i as usize]);
-                    positions.len() as u32 - 1
+                    used.push(i as usize);
+                    used.len() as u32 - 1
                 })
             })
             .collect();
+        let positions = used.iter().map(|&i| wide.positions[i]).collect();
+        let colors: Option<Vec<Vec4>> = wide.colors.as_ref().map(|colors| {
+            used.iter()
+                .map(|&i| colors.get(i).copied().unwrap_or(Vec4::ONE))
+                .collect()
+        });
         let name = format!("{} {k}", group.topology.name());
         scene.meshes.push(Mesh {
             name: name.clone(),
             positions,
+            colors,
             indices,
             topology: group.topology,
             material,

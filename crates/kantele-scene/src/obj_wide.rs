@@ -1,9 +1,10 @@
 //! OBJ `l` (polyline) and `p` (points) statements, which `tobj` does not read: the positions
 //! they use and their index lists, grouped by material in file order. A polyline `l a b c`
 //! becomes the segments `(a, b), (b, c)`; `v/vt` references use the position only; negative
-//! indices count back from the last `v` read so far.
+//! indices count back from the last `v` read so far. A file of vertices alone (no faces,
+//! lines or points) is read as one group of points, every vertex in file order.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 use kantele_rules::scene::Topology;
 
 use crate::obj_text::UNNAMED_MATERIAL;
@@ -24,32 +25,49 @@ pub(crate) struct WideGroup {
 pub(crate) struct ObjWide {
     /// Every `v` of the file, in order.
     pub positions: Vec<Vec3>,
+    /// The colour of every `v` (`v x y z r g b`; white for those without one), when at least
+    /// one has a colour.
+    pub colors: Option<Vec<Vec4>>,
     /// The statements' groups, in file order.
     pub groups: Vec<WideGroup>,
     /// One message per statement that could not be read (skipped).
     pub warnings: Vec<String>,
 }
 
-/// Reads the `v`, `usemtl`, `l` and `p` statements of OBJ text.
-pub(crate) fn read_lines_points(source: &str) -> ObjWide {
+/// Reads the `v`, `usemtl`, `l` and `p` statements of OBJ text (decoded and joined, see
+/// `obj_text`); with `all_points`, every vertex is also one point of a first group.
+pub(crate) fn read_lines_points(source: &str, all_points: bool) -> ObjWide {
     let mut out = ObjWide::default();
+    let mut colors: Vec<Vec4> = Vec::new();
+    let mut any_color = false;
     let mut material: Option<String> = None;
     for (number, line) in source.lines().enumerate() {
+        let line = line.trim_start();
         let mut words = line.split_whitespace();
         let keyword = words.next();
         match keyword {
             Some("v") => {
-                let mut c = [0.0f32; 3];
-                for value in &mut c {
-                    *value = words
-                        .next()
-                        .and_then(|w| w.parse().ok())
-                        .unwrap_or(f32::NAN);
+                let values: Vec<f32> = words
+                    .map(|w| w.parse().unwrap_or(f32::NAN))
+                    .take(7)
+                    .collect();
+                let value = |i: usize| values.get(i).copied().unwrap_or(f32::NAN);
+                out.positions.push(Vec3::new(value(0), value(1), value(2)));
+                if values.len() == 6 {
+                    any_color = true;
+                    colors.push(Vec4::new(value(3), value(4), value(5), 1.0));
+                } else {
+                    colors.push(Vec4::ONE);
                 }
-                out.positions.push(Vec3::from_array(c));
             }
             Some("usemtl") => {
-                material = Some(words.next().unwrap_or(UNNAMED_MATERIAL).to_string());
+                let name = line["usemtl".len()..].trim();
+                let name = if name.is_empty() {
+                    UNNAMED_MATERIAL
+                } else {
+                    name
+                };
+                material = Some(name.to_string());
             }
             Some(kind @ ("l" | "p")) => {
                 let count = out.positions.len();
@@ -95,7 +113,18 @@ pub(crate) fn read_lines_points(source: &str) -> ObjWide {
             _ => {}
         }
     }
+    if all_points {
+        out.groups.insert(
+            0,
+            WideGroup {
+                material: None,
+                topology: Topology::Points,
+                indices: (0..out.positions.len() as u32).collect(),
+            },
+        );
+    }
     out.groups.retain(|g| !g.indices.is_empty());
+    out.colors = any_color.then_some(colors);
     out
 }
 
@@ -106,8 +135,9 @@ mod tests {
     #[test]
     fn polylines_become_segments_and_points_keep_their_vertices() {
         let text = "v 0 0 0\nv 1 0 0\nv 1 1 0\nl 1 2 3\np 1/1 -1\nusemtl red\nl -3 -1\nl 9 1\n";
-        let wide = read_lines_points(text);
+        let wide = read_lines_points(text, false);
         assert_eq!(wide.positions.len(), 3);
+        assert_eq!(wide.colors, None);
         assert_eq!(
             wide.groups,
             vec![
@@ -130,5 +160,18 @@ mod tests {
         );
         assert_eq!(wide.warnings.len(), 1, "{:?}", wide.warnings);
         assert!(wide.warnings[0].starts_with("line 8:"));
+    }
+
+    #[test]
+    fn vertices_alone_are_points_with_their_colours() {
+        let wide = read_lines_points("v 0 0 0 1 0 0\nv 1 0 0\n  usemtl a b\np 2\n", true);
+        assert_eq!(wide.groups.len(), 2);
+        assert_eq!(wide.groups[0].topology, Topology::Points);
+        assert_eq!(wide.groups[0].indices, vec![0, 1]);
+        assert_eq!(wide.groups[1].material.as_deref(), Some("a b"));
+        assert_eq!(
+            wide.colors,
+            Some(vec![Vec4::new(1.0, 0.0, 0.0, 1.0), Vec4::ONE])
+        );
     }
 }
