@@ -170,7 +170,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
             name,
             base_color_factor: Vec4::new(diffuse[0], diffuse[1], diffuse[2], alpha),
             base_color_texture,
-            double_sided: false,
+            // OBJ states no winding: faces show from both sides.
+            double_sided: true,
             alpha_mode,
             unlit: false,
             // For PBR shading: a dielectric whose roughness follows the specular exponent
@@ -183,7 +184,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
             ..Material::default()
         });
     }
-    let mut default_material = None;
+    let mut default_index = None;
 
     for (model_index, model) in models.iter().enumerate() {
         let m = &model.mesh;
@@ -247,8 +248,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
                         "{what}: material {id} does not exist; using the default material"
                     ));
                 }
-                *default_material.get_or_insert_with(|| {
-                    scene.materials.push(Material::default());
+                *default_index.get_or_insert_with(|| {
+                    scene.materials.push(default_material());
                     scene.materials.len() - 1
                 })
             }
@@ -279,13 +280,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         });
     }
     if let Some(wide) = wide {
-        add_lines_points(
-            &mut scene,
-            &mut info,
-            wide,
-            &materials,
-            &mut default_material,
-        );
+        add_lines_points(&mut scene, &mut info, wide, &materials, &mut default_index);
     }
     if scene.draws.is_empty() {
         info.warn("the file has no faces, lines or points: nothing is drawn");
@@ -306,6 +301,16 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     Ok(LoadedScene { scene, info })
 }
 
+/// The material of faces without one: white, dielectric, fully rough and, as every OBJ
+/// material, double-sided.
+fn default_material() -> Material {
+    Material {
+        double_sided: true,
+        metallic: 0.0,
+        ..Material::default()
+    }
+}
+
 /// Adds a mesh and a draw for each group of `l` / `p` statements (or of the vertices of a file
 /// of vertices alone), with only the positions (and colours) it uses; its material is the
 /// `usemtl` in force (by name, the last of that name as in `tobj`), else the default one.
@@ -314,7 +319,7 @@ fn add_lines_points(
     info: &mut SceneInfo,
     wide: ObjWide,
     materials: &[tobj::Material],
-    default_material: &mut Option<usize>,
+    default_index: &mut Option<usize>,
 ) {
     for w in wide.warnings {
         info.warn(w);
@@ -327,8 +332,8 @@ fn add_lines_points(
                 .filter(|&i| i < scene.materials.len())
         });
         let material = named.unwrap_or_else(|| {
-            *default_material.get_or_insert_with(|| {
-                scene.materials.push(Material::default());
+            *default_index.get_or_insert_with(|| {
+                scene.materials.push(default_material());
                 scene.materials.len() - 1
             })
         });

@@ -105,7 +105,15 @@ fn obj_without_mtl_uses_the_default_material() {
         loaded.info.warnings
     );
     let scene = &loaded.scene;
-    assert_eq!(scene.materials, vec![kantele::scene::Material::default()]);
+    // OBJ's default material: white, dielectric, double-sided (OBJ states no winding).
+    assert_eq!(
+        scene.materials,
+        vec![kantele::scene::Material {
+            double_sided: true,
+            metallic: 0.0,
+            ..kantele::scene::Material::default()
+        }]
+    );
     assert_eq!(scene.triangle_count(), 2);
     let mesh = &scene.meshes[0];
     // Flat normals: 6 vertices, all +z.
