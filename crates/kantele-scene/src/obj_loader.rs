@@ -2,24 +2,20 @@
 
 use std::cell::RefCell;
 use std::collections::HashMap;
-use std::path::{Path, PathBuf};
-use std::sync::Arc;
+use std::path::Path;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
-use kantele_rules::scene::{
-    AlphaMode, Draw, Light, Material, Mesh, Scene, TextureBinding, Topology,
-};
-use kantele_rules::shade::texture::Texture;
+use kantele_rules::scene::{Draw, Light, Mesh, Scene, Topology};
 
 use crate::budget::Budget;
 use crate::ear_clip::triangulate_faces;
 use crate::mesh_util::{first_index_out_of_range, flat_normals, framing_camera};
-use crate::obj_text::{patch_mtl, patch_obj, text, texture_file_name, UNNAMED_MATERIAL};
+use crate::mtl_libraries::{MtlLibraries, MAX_LINE_WARNINGS};
+use crate::obj_material::{default_material, Converter};
+use crate::obj_text::{patch_obj, text, UNNAMED_MATERIAL};
+use crate::obj_textures::ObjTextures;
 use crate::obj_wide::{read_lines_points, ObjWide};
 use crate::read_policy::{read_regular_file, ReadPolicy};
-use crate::texture_util::{
-    decode_srgb_within, image_size, placeholder, trilinear_repeat, ImageError,
-};
 use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
 
 /// Bytes of memory charged per byte of OBJ text before parsing: the parser's vertices (with
@@ -51,139 +47,77 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     drop(source);
     let policy = ReadPolicy::new(path, &options.allow_read);
     let directory = path.parent().unwrap_or(Path::new("")).to_path_buf();
-    // The MTL loader runs inside tobj (a `Fn`): what it needs to change goes through cells.
+    // The MTL loader runs inside tobj (a `Fn`): what it changes goes through cells.
     let budget = RefCell::new(budget);
-    let material_dirs: RefCell<Vec<PathBuf>> = RefCell::new(Vec::new());
-    let mtl_warnings: RefCell<Vec<String>> = RefCell::new(Vec::new());
+    let libraries = RefCell::new(MtlLibraries::new(&directory, &policy));
     let load_mtl = |name: &Path| -> tobj::MTLLoadResult {
-        let file = directory.join(name.to_string_lossy().replace('\\', "/"));
-        let bytes = policy.read(&file, &mut budget.borrow_mut()).map_err(|e| {
-            mtl_warnings
-                .borrow_mut()
-                .push(format!("material library {}: {e}", name.display()));
-            tobj::LoadError::OpenFileFailed
-        })?;
-        let (mtl, warnings) = patch_mtl(&text(&bytes));
-        for w in warnings {
-            mtl_warnings
-                .borrow_mut()
-                .push(format!("material library {}: {w}", name.display()));
-        }
-        let result = tobj::load_mtl_buf(&mut std::io::Cursor::new(mtl.as_bytes()));
-        if let Ok((materials, _)) = &result {
-            let dir = file.parent().unwrap_or(Path::new("")).to_path_buf();
-            material_dirs
-                .borrow_mut()
-                .extend(std::iter::repeat_n(dir, materials.len()));
-        }
-        result
+        libraries
+            .borrow_mut()
+            .load(&name.to_string_lossy(), &mut budget.borrow_mut())
     };
     let tobj_options = tobj::LoadOptions {
         triangulate: false,
         single_index: true,
         ..Default::default()
     };
-    let (models, materials) = tobj::load_obj_buf(
+    let (models, _) = tobj::load_obj_buf(
         &mut std::io::Cursor::new(patched.text.as_bytes()),
         &tobj_options,
         load_mtl,
     )
     .map_err(|e| LoadError::invalid(path, format!("not a valid OBJ file: {e}")))?;
+    drop(patched);
     let mut budget = budget.into_inner();
-    let material_dirs = material_dirs.into_inner();
+    let libraries = libraries.into_inner();
+    if let Some(e) = &libraries.fatal {
+        return Err(LoadError::invalid(path, e));
+    }
+    if let Some(e) = libraries.first_missing.as_ref().filter(|_| options.strict) {
+        return Err(LoadError::invalid(path, e));
+    }
     let mut info = SceneInfo {
         source: path.display().to_string(),
         node_count: models.len(),
         ..SceneInfo::default()
     };
-    for w in mtl_warnings.into_inner() {
-        info.warn(w);
+    for w in &libraries.warnings {
+        info.warn(w.as_str());
+    }
+    for i in &libraries.ignored {
+        info.ignore(i.as_str());
     }
     let mut scene = Scene {
         light: Light::Headlight,
         resolution: (800, 600),
         ..Scene::default()
     };
-    let materials = match materials {
-        Ok(m) => m,
-        Err(e) => {
-            info.warn(format!(
-                "the material library could not be read ({e}); using the default material"
-            ));
-            Vec::new()
+    let mut textures = ObjTextures::new(&policy, options);
+    // Per material: the texture-coordinate scale and offset of its textures.
+    let mut material_uv: Vec<Option<(Vec2, Vec2)>> = Vec::new();
+    for (m, folder) in &libraries.materials {
+        let converted = Converter {
+            textures: &mut textures,
+            scene: &mut scene,
+            info: &mut info,
+            budget: &mut budget,
         }
-    };
-    let mut texture_files: HashMap<PathBuf, Option<usize>> = HashMap::new();
-    for (material_index, m) in materials.iter().enumerate() {
-        let base_color_texture = match m.diffuse_texture.as_deref().map(texture_file_name) {
-            Some(name) if !name.is_empty() => {
-                // Relative to the folder of the MTL file that names it.
-                let folder = material_dirs.get(material_index).unwrap_or(&directory);
-                let file = folder.join(name.replace('\\', "/"));
-                let texture = match texture_files.get(&file) {
-                    Some(&t) => t,
-                    None => {
-                        let what = format!("material '{}': texture {}", m.name, file.display());
-                        let t = match load_texture(&file, &policy, &mut budget, options) {
-                            Ok(texture) => {
-                                scene.textures.push(Arc::new(texture.0));
-                                info.texture_sizes.push(texture.1);
-                                Some(scene.textures.len() - 1)
-                            }
-                            Err(ImageError::Budget(e)) => {
-                                return Err(LoadError::invalid(path, format!("{what}: {e}")))
-                            }
-                            Err(ImageError::Decode(e)) if options.strict => {
-                                return Err(LoadError::invalid(path, format!("{what}: {e}")))
-                            }
-                            Err(ImageError::Decode(e)) => {
-                                info.warn(format!(
-                                    "{what}: {e}; drawn untextured (--strict makes this an error)"
-                                ));
-                                None
-                            }
-                        };
-                        texture_files.insert(file.clone(), t);
-                        t
-                    }
-                };
-                texture.map(|texture| TextureBinding {
-                    texture,
-                    sampler: trilinear_repeat(),
-                })
-            }
-            _ => None,
-        };
-        let diffuse = m.diffuse.unwrap_or([1.0; 3]);
-        let dissolve = m.dissolve.unwrap_or(1.0);
-        let (alpha, alpha_mode) = if dissolve.is_finite() && dissolve < 1.0 {
-            (dissolve.max(0.0), AlphaMode::Blend)
-        } else {
-            (1.0, AlphaMode::Opaque)
-        };
-        let name = if m.name == UNNAMED_MATERIAL {
-            String::new()
-        } else {
-            m.name.clone()
-        };
-        scene.materials.push(Material {
-            name,
-            base_color_factor: Vec4::new(diffuse[0], diffuse[1], diffuse[2], alpha),
-            base_color_texture,
-            // OBJ states no winding: faces show from both sides.
-            double_sided: true,
-            alpha_mode,
-            unlit: false,
-            // For PBR shading: a dielectric whose roughness follows the specular exponent
-            // (`Ns`, Blender's conversion `√(2 / (Ns + 2))`), fully rough without one.
-            metallic: 0.0,
-            roughness: m
-                .shininess
-                .filter(|s| s.is_finite() && *s >= 0.0)
-                .map_or(1.0, |s| (2.0 / (s + 2.0)).sqrt()),
-            ..Material::default()
-        });
+        .convert(m, folder)
+        .map_err(|e| LoadError::invalid(path, e))?;
+        scene.materials.push(converted.material);
+        material_uv.push(converted.uv);
     }
+    textures.finish(&mut info);
+    let material_names: Vec<String> = libraries
+        .materials
+        .iter()
+        .map(|(m, _)| {
+            if m.name.is_empty() {
+                UNNAMED_MATERIAL.to_string()
+            } else {
+                m.name.clone()
+            }
+        })
+        .collect();
     let mut default_index = None;
 
     for (model_index, model) in models.iter().enumerate() {
@@ -209,11 +143,19 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
                 "{what}: only some vertices have normals; using flat normals"
             ));
         }
-        // OBJ's v runs upwards; glTF's (and Kantele's) downwards from the image's top row.
+        // The material's `-s` / `-o`; then OBJ's v, which runs upwards, turned to glTF's (and
+        // Kantele's), which runs downwards from the image's top row.
+        let (scale, offset) = m
+            .material_id
+            .and_then(|id| material_uv.get(id).copied().flatten())
+            .unwrap_or((Vec2::ONE, Vec2::ZERO));
         let texcoords = (m.texcoords.len() == 2 * n).then(|| {
             m.texcoords
                 .chunks_exact(2)
-                .map(|t| Vec2::new(t[0], 1.0 - t[1]))
+                .map(|t| {
+                    let uv = Vec2::new(t[0], t[1]) * scale + offset;
+                    Vec2::new(uv.x, 1.0 - uv.y)
+                })
                 .collect::<Vec<_>>()
         });
         let colors = (m.vertex_color.len() == 3 * n).then(|| {
@@ -280,7 +222,13 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         });
     }
     if let Some(wide) = wide {
-        add_lines_points(&mut scene, &mut info, wide, &materials, &mut default_index);
+        add_lines_points(
+            &mut scene,
+            &mut info,
+            wide,
+            &material_names,
+            &mut default_index,
+        );
     }
     if scene.draws.is_empty() {
         info.warn("the file has no faces, lines or points: nothing is drawn");
@@ -301,16 +249,6 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     Ok(LoadedScene { scene, info })
 }
 
-/// The material of faces without one: white, dielectric, fully rough and, as every OBJ
-/// material, double-sided.
-fn default_material() -> Material {
-    Material {
-        double_sided: true,
-        metallic: 0.0,
-        ..Material::default()
-    }
-}
-
 /// Adds a mesh and a draw for each group of `l` / `p` statements (or of the vertices of a file
 /// of vertices alone), with only the positions (and colours) it uses; its material is the
 /// `usemtl` in force (by name, the last of that name as in `tobj`), else the default one.
@@ -318,17 +256,24 @@ fn add_lines_points(
     scene: &mut Scene,
     info: &mut SceneInfo,
     wide: ObjWide,
-    materials: &[tobj::Material],
+    material_names: &[String],
     default_index: &mut Option<usize>,
 ) {
-    for w in wide.warnings {
+    let skipped = wide.warnings.len();
+    for w in wide.warnings.into_iter().take(MAX_LINE_WARNINGS) {
         info.warn(w);
+    }
+    if skipped > MAX_LINE_WARNINGS {
+        info.warn(format!(
+            "{} more l / p statements with a bad vertex reference are skipped",
+            skipped - MAX_LINE_WARNINGS
+        ));
     }
     for (k, group) in wide.groups.into_iter().enumerate() {
         let named = group.material.as_ref().and_then(|name| {
-            materials
+            material_names
                 .iter()
-                .rposition(|m| &m.name == name)
+                .rposition(|m| m == name)
                 .filter(|&i| i < scene.materials.len())
         });
         let material = named.unwrap_or_else(|| {
@@ -372,26 +317,4 @@ fn add_lines_points(
             node_index: info.node_count + k,
         });
     }
-}
-
-/// Reads and decodes a texture file under the read policy and budget (a placeholder when
-/// textures are not decoded); with its header size.
-fn load_texture(
-    file: &Path,
-    policy: &ReadPolicy,
-    budget: &mut Budget,
-    options: &LoadOptions,
-) -> Result<(Texture, (u32, u32)), ImageError> {
-    let bytes = policy.read(file, budget).map_err(|e| {
-        if e.contains("memory budget") {
-            ImageError::Budget(e)
-        } else {
-            ImageError::Decode(e)
-        }
-    })?;
-    let size = image_size(&bytes, None)?;
-    if !options.decode_textures {
-        return Ok((placeholder(), size));
-    }
-    Ok((decode_srgb_within(&bytes, None, budget)?, size))
 }

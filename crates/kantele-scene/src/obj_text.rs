@@ -9,8 +9,6 @@
 //!   (`obj_wide` reads them), an empty `usemtl` names the unnamed material, `usemtl` and
 //!   `mtllib` take their name after any run of blanks, and when only some `v` lines carry a
 //!   colour the others get white (`tobj` would misalign or refuse them).
-//! - In MTL text, one-value colour lines (`Kd 0.8`) are widened, malformed colour lines are
-//!   dropped with a warning and empty material names get a name.
 
 /// The name given to materials declared with an empty `newmtl` (and used by an empty
 /// `usemtl`); reported as an empty name.
@@ -159,75 +157,6 @@ fn white_vertex(line: &str) -> String {
     }
 }
 
-/// Patches MTL text for `tobj`; returns the text and one warning per line it had to drop.
-pub(crate) fn patch_mtl(source: &str) -> (String, Vec<String>) {
-    let mut text = String::with_capacity(source.len());
-    let mut warnings = Vec::new();
-    for (number, line) in source.lines().enumerate() {
-        let mut words = line.split_whitespace();
-        let key = words.next();
-        let values: Vec<&str> = words.collect();
-        match key {
-            Some("newmtl") if values.is_empty() => {
-                text.push_str("newmtl ");
-                text.push_str(UNNAMED_MATERIAL);
-            }
-            Some(k @ ("Ka" | "Kd" | "Ks" | "Ke" | "Tf")) => {
-                let numbers: Option<Vec<f32>> = values.iter().map(|v| v.parse().ok()).collect();
-                match numbers.as_deref() {
-                    Some(&[v]) => text.push_str(&format!("{k} {v} {v} {v}")),
-                    Some(&[_, _, _]) => text.push_str(line),
-                    _ => {
-                        warnings.push(format!(
-                            "line {}: '{}' is not a colour; the default is used",
-                            number + 1,
-                            line.trim()
-                        ));
-                        continue;
-                    }
-                }
-            }
-            Some(k @ ("d" | "Tr" | "Ns" | "Ni" | "illum")) => {
-                if values.len() != 1 || values[0].parse::<f32>().is_err() {
-                    warnings.push(format!(
-                        "line {}: '{}' is not a {k} value; the default is used",
-                        number + 1,
-                        line.trim()
-                    ));
-                    continue;
-                }
-                text.push_str(line);
-            }
-            _ => text.push_str(line),
-        }
-        text.push('\n');
-    }
-    (text, warnings)
-}
-
-/// The file name in a texture statement's value, without options such as `-s 1 1 1` or
-/// `-bm 0.5` (the name is what follows the last option's arguments; names may hold spaces).
-pub(crate) fn texture_file_name(value: &str) -> &str {
-    let value = value.trim();
-    if !value.starts_with('-') {
-        return value;
-    }
-    // Options take numeric arguments (or on/off); the name is the first word after them that
-    // is neither an option nor an argument.
-    let mut rest = value;
-    loop {
-        let trimmed = rest.trim_start();
-        let word_end = trimmed.find(char::is_whitespace).unwrap_or(trimmed.len());
-        let word = &trimmed[..word_end];
-        let is_argument =
-            word.starts_with('-') || word.parse::<f32>().is_ok() || matches!(word, "on" | "off");
-        if !is_argument || word_end == trimmed.len() {
-            return trimmed;
-        }
-        rest = &trimmed[word_end..];
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -282,27 +211,5 @@ mod tests {
         );
         let p = patch_obj("v 0 0 0\nv 1 0 0\n");
         assert_eq!(p.text, "v 0 0 0\nv 1 0 0\n");
-    }
-
-    #[test]
-    fn mtl_colours_are_widened_or_dropped() {
-        let (text, warnings) = patch_mtl("newmtl\nKd 0.8\nKa 1 1\nKs 1 2 3\nd x\n");
-        assert_eq!(
-            text,
-            format!("newmtl {UNNAMED_MATERIAL}\nKd 0.8 0.8 0.8\nKs 1 2 3\n")
-        );
-        assert_eq!(warnings.len(), 2);
-        assert!(warnings[0].starts_with("line 3"), "{warnings:?}");
-    }
-
-    #[test]
-    fn texture_options_are_skipped() {
-        assert_eq!(texture_file_name("wood.png"), "wood.png");
-        assert_eq!(texture_file_name("my wood.png"), "my wood.png");
-        assert_eq!(texture_file_name("-s 1 1 1 wood.png"), "wood.png");
-        assert_eq!(
-            texture_file_name("-clamp on -bm 0.5 my wood.png"),
-            "my wood.png"
-        );
     }
 }

@@ -49,19 +49,11 @@ pub(crate) fn image_size(bytes: &[u8], mime_type: Option<&str>) -> Result<(u32, 
         .map_err(|e| ImageError::Decode(format!("cannot decode image: {e}")))
 }
 
-/// Decodes an encoded PNG, JPEG or WebP image into an sRGB texture with its mip chain, after
-/// reading its size from the header and charging the texture's memory to `budget`. The format
-/// is recognised from the data, `mime_type` is the fallback.
-pub(crate) fn decode_srgb_within(
-    bytes: &[u8],
-    mime_type: Option<&str>,
-    budget: &mut Budget,
-) -> Result<Texture, ImageError> {
-    decode_within(bytes, mime_type, ColorSpace::Srgb, budget)
-}
-
-/// [`decode_srgb_within`] for a texture whose texels are encoded in `color_space` (linear for
-/// data such as normals, metallic-roughness and occlusion).
+/// Decodes an encoded PNG, JPEG or WebP image into a texture with its mip chain whose texels
+/// are encoded in `color_space` (sRGB for colours, linear for data such as normals,
+/// metallic-roughness and occlusion), after reading its size from the header and charging the
+/// texture's memory to `budget`. The format is recognised from the data, `mime_type` is the
+/// fallback.
 pub(crate) fn decode_within(
     bytes: &[u8],
     mime_type: Option<&str>,
@@ -103,7 +95,7 @@ pub(crate) fn decode_within(
 #[cfg(test)]
 fn decode_srgb(bytes: &[u8], mime_type: Option<&str>) -> Result<Texture, String> {
     let mut budget = Budget::new(crate::DEFAULT_MAX_MEMORY);
-    decode_srgb_within(bytes, mime_type, &mut budget).map_err(|e| match e {
+    decode_within(bytes, mime_type, ColorSpace::Srgb, &mut budget).map_err(|e| match e {
         ImageError::Budget(m) | ImageError::Decode(m) => m,
     })
 }
