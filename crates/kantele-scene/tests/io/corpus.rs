@@ -354,6 +354,37 @@ fn concave_obj_face_keeps_its_notch() {
     assert!((ratio - 0.75).abs() < 0.02, "L / square = {ratio}");
 }
 
+/// OBJ states no winding: a single quad seen from behind is drawn (its material is
+/// double-sided), where culling would leave the same view empty.
+#[test]
+fn single_obj_quad_seen_from_behind_draws() {
+    let dir = temp_dir("corpus-obj-behind");
+    let path = dir.join("quad.obj");
+    // Counter-clockwise seen from +z: its front faces +z; the camera looks from −z.
+    std::fs::write(&path, "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3 4\n").unwrap();
+    let mut scene = load(&path).scene;
+    scene.camera = kantele::scene::Camera::framing(
+        glam::Vec3::new(0.5, 0.5, 0.0),
+        1.0,
+        -glam::Vec3::Z,
+        4.0 / 3.0,
+    );
+    assert!(scene.materials.iter().all(|m| m.double_sided));
+    assert!(
+        coverage(&render(&scene, Pass::Color)) > 0,
+        "the quad shows from behind"
+    );
+    let mut culled = scene.clone();
+    for m in &mut culled.materials {
+        m.double_sided = false;
+    }
+    assert_eq!(
+        coverage(&render(&culled, Pass::Color)),
+        0,
+        "single-sided, the camera sees its back"
+    );
+}
+
 /// The real-world samples (`$KANTELE_SHARED/realworld`), or `None` (with a printed reason)
 /// when they are absent; absent and required (`KANTELE_REQUIRE` contains `realworld`) fails.
 fn realworld() -> Option<PathBuf> {

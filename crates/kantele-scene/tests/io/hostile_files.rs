@@ -360,3 +360,128 @@ fn ply_and_stl_arrays_are_charged_to_the_budget() {
         20_000
     );
 }
+
+/// `\` continuation lines without end: a million of them, and one on the last line of the
+/// file, in OBJ and MTL files, make one long line, read once.
+#[test]
+fn obj_continuation_lines_without_end() {
+    let dir = temp_dir("obj-continued");
+    let endless = b"\\\n".repeat(1_000_000);
+    let mut mtl = b"newmtl m\nKd 1 0 0 \\\n".to_vec();
+    mtl.extend_from_slice(&endless);
+    mtl.push(b'\\');
+    std::fs::write(dir.join("c.mtl"), mtl).unwrap();
+    let mut obj = b"mtllib c.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3 \\\n".to_vec();
+    obj.extend_from_slice(&endless);
+    obj.push(b'\\');
+    let path = dir.join("c.obj");
+    std::fs::write(&path, obj).unwrap();
+    let started = std::time::Instant::now();
+    let loaded = load_scene(&path).expect("loads");
+    assert!(started.elapsed().as_secs() < 10, "{:?}", started.elapsed());
+    assert_eq!(loaded.scene.triangle_count(), 1);
+    assert_eq!(
+        loaded.scene.materials[0].base_color_factor,
+        glam::Vec4::new(1.0, 0.0, 0.0, 1.0)
+    );
+}
+
+/// Huge UTF-16 OBJ and MTL files are charged to the budget as any text is (refused under a
+/// small one), and load within the memory they are charged for.
+#[test]
+fn huge_utf16_obj_and_mtl_files() {
+    let dir = temp_dir("obj-utf16-huge");
+    let utf16 = |text: &str, repeat: usize, big_endian: bool| -> Vec<u8> {
+        let units: Vec<u16> = text.encode_utf16().collect();
+        let mut out = if big_endian {
+            vec![0xfe, 0xff]
+        } else {
+            vec![0xff, 0xfe]
+        };
+        out.reserve(units.len() * 2 * repeat);
+        for _ in 0..repeat {
+            for u in &units {
+                out.extend_from_slice(&if big_endian {
+                    u.to_be_bytes()
+                } else {
+                    u.to_le_bytes()
+                });
+            }
+        }
+        out
+    };
+    // 16 MB of vertices: a point cloud of 800 000 points.
+    let path = dir.join("huge16.obj");
+    std::fs::write(&path, utf16("v 0.5 1 2\n", 800_000, false)).unwrap();
+    let small = LoadOptions {
+        max_memory: 64 << 20,
+        ..LoadOptions::default()
+    };
+    let err = load_scene_with(&path, &small)
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        err.contains("memory budget") && err.contains("huge16.obj"),
+        "{err}"
+    );
+    let (ok, text) = load_in_capped_child(&path, 1024);
+    assert!(ok && text.contains("CHILD: loaded"), "{text}");
+    // An 8 MB UTF-16 material library.
+    std::fs::write(
+        dir.join("big.mtl"),
+        utf16("newmtl a\nKd 1 1 1\n", 200_000, true),
+    )
+    .unwrap();
+    let path = dir.join("mtl16.obj");
+    std::fs::write(
+        &path,
+        "mtllib big.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl a\nf 1 2 3\n",
+    )
+    .unwrap();
+    let tight = LoadOptions {
+        max_memory: 32 << 20,
+        ..LoadOptions::default()
+    };
+    let err = load_scene_with(&path, &tight)
+        .expect_err("refused")
+        .to_string();
+    assert!(
+        err.contains("memory budget") && err.contains("mtl16.obj") && err.contains("big.mtl"),
+        "{err}"
+    );
+    assert_eq!(load_scene(&path).expect("loads").scene.triangle_count(), 1);
+}
+
+/// A `mtllib` line with 200 000 names and 100 000 lines naming the same library: at most
+/// `MAX_LIBRARIES` (64) libraries are tried, each once, with a bounded number of warnings.
+#[test]
+fn many_material_library_names() {
+    let dir = temp_dir("obj-mtllibs");
+    std::fs::write(dir.join("a.mtl"), "newmtl m\nKd 1 0 0\n").unwrap();
+    let mut obj = String::from("mtllib a.mtl\nmtllib");
+    for i in 0..200_000 {
+        obj.push_str(&format!(" missing{i}.mtl"));
+    }
+    obj.push('\n');
+    obj.push_str(&"mtllib a.mtl\n".repeat(100_000));
+    obj.push_str("v 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl m\nf 1 2 3\n");
+    let path = dir.join("many.obj");
+    std::fs::write(&path, obj).unwrap();
+    let started = std::time::Instant::now();
+    let loaded = load_scene(&path).expect("loads");
+    assert!(started.elapsed().as_secs() < 10, "{:?}", started.elapsed());
+    let scene = &loaded.scene;
+    assert_eq!(scene.materials.len(), 1, "a.mtl is read once");
+    assert_eq!(
+        scene.materials[0].base_color_factor,
+        glam::Vec4::new(1.0, 0.0, 0.0, 1.0)
+    );
+    let warnings = &loaded.info.warnings;
+    assert!(warnings.len() <= 70, "{} warnings", warnings.len());
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains("more than 64 material libraries")),
+        "{warnings:?}"
+    );
+}

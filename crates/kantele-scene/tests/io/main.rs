@@ -16,6 +16,7 @@ mod gltf_files;
 mod hostile_files;
 mod isa_identical;
 mod obj_files;
+mod obj_materials;
 mod ply_stl_files;
 mod reference_scenes;
 mod spec_gloss;
