@@ -190,6 +190,7 @@ fn ignore(ignored: &mut Vec<String>, what: &str) {
 
 /// `text` after its first word when that word is `word` (any case).
 fn strip_word<'a>(text: &'a str, word: &str) -> Option<&'a str> {
+    let text = text.trim_start();
     let first = text.split_whitespace().next()?;
     first
         .eq_ignore_ascii_case(word)

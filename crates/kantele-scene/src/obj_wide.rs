@@ -52,7 +52,11 @@ pub(crate) fn read_lines_points(source: &str, all_points: bool) -> ObjWide {
                     .take(7)
                     .collect();
                 let value = |i: usize| values.get(i).copied().unwrap_or(f32::NAN);
-                out.positions.push(Vec3::new(value(0), value(1), value(2)));
+                let position = Vec3::new(value(0), value(1), value(2));
+                // `v x y z w`: homogeneous, as `tobj` reads it.
+                let w = if values.len() == 4 { value(3) } else { 1.0 };
+                out.positions
+                    .push(if w != 0.0 { position / w } else { position });
                 if values.len() == 6 {
                     any_color = true;
                     colors.push(Vec4::new(value(3), value(4), value(5), 1.0));
@@ -164,8 +168,9 @@ mod tests {
 
     #[test]
     fn vertices_alone_are_points_with_their_colours() {
-        let wide = read_lines_points("v 0 0 0 1 0 0\nv 1 0 0\n  usemtl a b\np 2\n", true);
+        let wide = read_lines_points("v 0 0 0 1 0 0\nv 2 0 0 2\n  usemtl a b\np 2\n", true);
         assert_eq!(wide.groups.len(), 2);
+        assert_eq!(wide.positions[1], Vec3::X);
         assert_eq!(wide.groups[0].topology, Topology::Points);
         assert_eq!(wide.groups[0].indices, vec![0, 1]);
         assert_eq!(wide.groups[1].material.as_deref(), Some("a b"));
