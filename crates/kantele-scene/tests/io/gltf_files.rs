@@ -359,7 +359,7 @@ fn unsupported_extensions_warn_and_unreadable_required_ones_fail() {
     let mut g = textured_quad();
     g.json["extensionsUsed"] = json!([
         "KHR_lights_punctual",
-        "KHR_materials_clearcoat",
+        "KHR_materials_sheen",
         "EXT_fancy"
     ]);
     g.json["extensionsRequired"] = json!(["EXT_fancy"]);
@@ -371,7 +371,7 @@ fn unsupported_extensions_warn_and_unreadable_required_ones_fail() {
     let ignored: Vec<&String> = w.iter().filter(|w| w.starts_with("ignored")).collect();
     assert_eq!(ignored.len(), 1, "{w:?}");
     assert!(
-        ignored[0].contains("KHR_materials_clearcoat") && ignored[0].contains("EXT_fancy"),
+        ignored[0].contains("KHR_materials_sheen") && ignored[0].contains("EXT_fancy"),
         "{w:?}"
     );
     assert!(
