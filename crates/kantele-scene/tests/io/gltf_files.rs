@@ -357,11 +357,7 @@ fn camera_and_light_come_from_the_first_nodes_in_draw_order() {
 fn unsupported_extensions_warn_and_unreadable_required_ones_fail() {
     let dir = temp_dir("extensions");
     let mut g = textured_quad();
-    g.json["extensionsUsed"] = json!([
-        "KHR_lights_punctual",
-        "KHR_materials_sheen",
-        "EXT_fancy"
-    ]);
+    g.json["extensionsUsed"] = json!(["KHR_lights_punctual", "KHR_materials_sheen", "EXT_fancy"]);
     g.json["extensionsRequired"] = json!(["EXT_fancy"]);
     let path = dir.join("fancy.glb");
     g.write_glb(&path);
