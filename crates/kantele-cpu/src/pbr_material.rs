@@ -307,7 +307,6 @@ impl PbrShader<'_> {
         let lanes = f.lanes();
         let all = lanes.mask_all(true);
         let one = lanes.splat_f32(1.0);
-        let zero = lanes.splat_f32(0.0);
         let m = self.material;
         let needs_alpha = !matches!(m.alpha_mode, AlphaMode::Opaque);
         if self.pass == Pass::Ids && !needs_alpha {
@@ -315,8 +314,15 @@ impl PbrShader<'_> {
         }
         let texels = self.sample_textures(f);
         // --- base colour and alpha ---
-        let factor = m.base_color_factor.to_array();
-        let mut base = factor.map(|c| lanes.splat_f32(c));
+        // No `[T; N]::map` or other closure-taking helper on lanes here: LLVM may keep its body
+        // out of line, compiled without the kernel's instruction set (see `kantele_lanes`).
+        let factor = m.base_color_factor;
+        let mut base = [
+            lanes.splat_f32(factor.x),
+            lanes.splat_f32(factor.y),
+            lanes.splat_f32(factor.z),
+            lanes.splat_f32(factor.w),
+        ];
         if self.vertex_colors {
             for (c, b) in base.iter_mut().enumerate() {
                 *b = *b * f.varying(at::COLOR + c);
@@ -340,8 +346,12 @@ impl PbrShader<'_> {
             return ([normal[0], normal[1], normal[2], one], keep);
         }
         // --- emission ---
-        let e = m.emissive.to_array();
-        let mut emissive = e.map(|c| lanes.splat_f32(c));
+        let e = m.emissive;
+        let mut emissive = [
+            lanes.splat_f32(e.x),
+            lanes.splat_f32(e.y),
+            lanes.splat_f32(e.z),
+        ];
         if self.textures.emissive.is_some() {
             for c in 0..3 {
                 emissive[c] = emissive[c] * texels[EMISSIVE][c];
@@ -361,14 +371,19 @@ impl PbrShader<'_> {
                 metallic = metallic * texel[2];
                 roughness = roughness * texel[1];
             }
-            let clamp = |x: L::F32| x.max(zero).min(one);
+            let clamp = |x: L::F32| clamp01(lanes, x);
             let mut occlusion = one;
             if self.textures.occlusion.is_some() {
                 let texel = texels[OCCLUSION];
                 occlusion = one + lanes.splat_f32(m.occlusion_strength) * (texel[0] - one);
             }
             // KHR_materials_ior and KHR_materials_specular.
-            let mut dielectric_f0 = m.dielectric_f0.to_array().map(|c| lanes.splat_f32(c));
+            let f0 = m.dielectric_f0;
+            let mut dielectric_f0 = [
+                lanes.splat_f32(f0.x),
+                lanes.splat_f32(f0.y),
+                lanes.splat_f32(f0.z),
+            ];
             if self.textures.specular_color.is_some() {
                 for c in 0..3 {
                     dielectric_f0[c] = dielectric_f0[c] * texels[SPECULAR_COLOR][c];
@@ -379,7 +394,7 @@ impl PbrShader<'_> {
                 specular_weight = specular_weight * texels[SPECULAR][3];
             }
             // KHR_materials_clearcoat.
-            let clearcoat = m.has_clearcoat().then(|| {
+            let clearcoat = if m.has_clearcoat() {
                 let mut factor = lanes.splat_f32(m.clearcoat);
                 if self.textures.clearcoat.is_some() {
                     factor = factor * texels[CLEARCOAT][0];
@@ -388,12 +403,14 @@ impl PbrShader<'_> {
                 if self.textures.clearcoat_roughness.is_some() {
                     roughness = roughness * texels[CLEARCOAT_ROUGHNESS][1];
                 }
-                ClearcoatLayer {
+                Some(ClearcoatLayer {
                     factor: clamp(factor),
                     roughness: clamp(roughness),
                     normal: coat_normal,
-                }
-            });
+                })
+            } else {
+                None
+            };
             let surface = Surface {
                 base: [base[0], base[1], base[2]],
                 metallic: clamp(metallic),
@@ -405,7 +422,11 @@ impl PbrShader<'_> {
                     f.varying(at::POSITION + 1),
                     f.varying(at::POSITION + 2),
                 ],
-                dielectric_f0: dielectric_f0.map(|c| c.min(one)),
+                dielectric_f0: [
+                    dielectric_f0[0].min(one),
+                    dielectric_f0[1].min(one),
+                    dielectric_f0[2].min(one),
+                ],
                 specular_weight: clamp(specular_weight),
                 clearcoat,
             };
@@ -447,7 +468,8 @@ impl PbrShader<'_> {
             }
         }
         if m.double_sided && !f.front_facing() {
-            normals.map(|n| n.map(|c| -c))
+            let [n, c] = normals;
+            [[-n[0], -n[1], -n[2]], [-c[0], -c[1], -c[2]]]
         } else {
             normals
         }
@@ -513,6 +535,12 @@ impl PbrShader<'_> {
             lanes.splat_f32(1.0),
         ]
     }
+}
+
+/// `x` clamped to [0, 1] per lane (NaN gives 0).
+#[inline(always)]
+fn clamp01<L: Lanes>(lanes: L, x: L::F32) -> L::F32 {
+    x.max(lanes.splat_f32(0.0)).min(lanes.splat_f32(1.0))
 }
 
 /// `ng` bent by a normal texture's `texel` in the tangent frame `[t, b]`

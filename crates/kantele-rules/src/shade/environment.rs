@@ -254,7 +254,12 @@ pub fn brdf_ab_lanes<L: Lanes>(lanes: L, n_dot_v: L::F32, roughness: L::F32) -> 
     let mut out = [zero; 2];
     for (c, o) in out.iter_mut().enumerate() {
         let channel = lanes.splat_i32(c as i32);
-        let t = corners.map(|i| L::F32::from_bits((i + channel).gather_u32(table)));
+        let t = [
+            gather_f32::<L>(corners[0] + channel, table),
+            gather_f32::<L>(corners[1] + channel, table),
+            gather_f32::<L>(corners[2] + channel, table),
+            gather_f32::<L>(corners[3] + channel, table),
+        ];
         let top = t[0] + (t[1] - t[0]) * fx;
         let bottom = t[2] + (t[3] - t[2]) * fx;
         *o = top + (bottom - top) * fy;
@@ -273,7 +278,19 @@ fn normalize_or_zero_lanes<L: Lanes>(lanes: L, v: [L::F32; 3]) -> [L::F32; 3] {
         .abs()
         .simd_lt(lanes.splat_f32(f32::INFINITY))
         .and(rcp.simd_gt(zero));
-    v.map(|c| usable.select_f32(c * rcp, zero))
+    [
+        usable.select_f32(v[0] * rcp, zero),
+        usable.select_f32(v[1] * rcp, zero),
+        usable.select_f32(v[2] * rcp, zero),
+    ]
+}
+
+/// The `f32` whose bits `table` holds at `index`, per lane (see [`I32x8::gather_u32`]). Lane
+/// code here never hands lanes to closure-taking helpers such as `[T; N]::map`: LLVM may
+/// keep their bodies out of line, compiled without the kernel's instruction set.
+#[inline(always)]
+fn gather_f32<L: Lanes>(index: L::I32, table: &[u32]) -> L::F32 {
+    L::F32::from_bits(index.gather_u32(table))
 }
 
 /// [`octahedral_encode`] per lane, operation for operation.
@@ -326,7 +343,12 @@ fn sample_level_lanes<L: Lanes>(
     let mut out = [zero; 3];
     for (c, o) in out.iter_mut().enumerate() {
         let channel = lanes.splat_i32(c as i32);
-        let t = corners.map(|i| L::F32::from_bits((i + channel).gather_u32(table)));
+        let t = [
+            gather_f32::<L>(corners[0] + channel, table),
+            gather_f32::<L>(corners[1] + channel, table),
+            gather_f32::<L>(corners[2] + channel, table),
+            gather_f32::<L>(corners[3] + channel, table),
+        ];
         let top = t[0] + (t[1] - t[0]) * fx;
         let bottom = t[2] + (t[3] - t[2]) * fx;
         *o = top + (bottom - top) * fy;

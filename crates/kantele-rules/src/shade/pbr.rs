@@ -270,10 +270,13 @@ fn reflectance<L: Lanes>(lanes: L, s: &Surface<L>) -> Reflectance<L> {
         s.base[2] * dielectric,
     ];
     let w = s.specular_weight;
-    let f0 = std::array::from_fn(|c| {
-        let weighted = s.dielectric_f0[c] * w;
-        weighted + (s.base[c] - weighted) * s.metallic
-    });
+    let d = &s.dielectric_f0;
+    let weighted = [d[0] * w, d[1] * w, d[2] * w];
+    let f0 = [
+        weighted[0] + (s.base[0] - weighted[0]) * s.metallic,
+        weighted[1] + (s.base[1] - weighted[1]) * s.metallic,
+        weighted[2] + (s.base[2] - weighted[2]) * s.metallic,
+    ];
     Reflectance {
         c_diff,
         f0,
@@ -493,12 +496,11 @@ fn image_based<L: Lanes>(
     let coat = s.clearcoat.as_ref();
     // The specular lookups of the base and of the coat, from one call site: each call site of
     // the lookups is compiled into every kernel.
-    let lobes = [
-        (s.normal, s.roughness),
-        coat.map_or((s.normal, s.roughness), |layer| {
-            (layer.normal, layer.roughness)
-        }),
-    ];
+    let coat_lobe = match coat {
+        Some(layer) => (layer.normal, layer.roughness),
+        None => (s.normal, s.roughness),
+    };
+    let lobes = [(s.normal, s.roughness), coat_lobe];
     let count = if coat.is_some() { 2 } else { 1 };
     let mut reads = [([zero; 3], zero, zero); 2];
     for ((n, roughness), read) in lobes[..count].iter().zip(&mut reads) {
