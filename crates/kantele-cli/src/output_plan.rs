@@ -74,14 +74,16 @@ pub fn input_files(input: &Input) -> Vec<PathBuf> {
             }
         }
         "obj" => {
-            let Ok(text) = std::fs::read_to_string(path) else {
+            let Ok(bytes) = std::fs::read(path) else {
                 return files;
             };
-            for lib in names_after(&text, &["mtllib"]) {
+            let text = kantele_scene::obj_text(&bytes);
+            for lib in names_after(&text, |k| k == "mtllib") {
                 let mtl = dir.join(&lib);
-                if let Ok(mtl_text) = std::fs::read_to_string(&mtl) {
+                if let Ok(mtl_bytes) = std::fs::read(&mtl) {
+                    let mtl_text = kantele_scene::obj_text(&mtl_bytes);
                     let mtl_dir = mtl.parent().unwrap_or(Path::new("")).to_path_buf();
-                    for map in names_after(&mtl_text, &["map_kd", "map_ka", "map_d", "bump"]) {
+                    for map in names_after(&mtl_text, is_texture_statement) {
                         files.push(mtl_dir.join(map));
                     }
                 }
@@ -93,19 +95,37 @@ pub fn input_files(input: &Input) -> Vec<PathBuf> {
     files
 }
 
-/// The last word of every line starting with one of `keywords` (case-insensitive).
-fn names_after(text: &str, keywords: &[&str]) -> Vec<String> {
-    text.lines()
-        .filter_map(|line| {
-            let mut words = line.split_whitespace();
-            let first = words.next()?.to_ascii_lowercase();
-            if keywords.contains(&first.as_str()) {
-                words.last().map(str::to_string)
-            } else {
-                None
+/// MTL statements that name a texture file (`map_Kd`, `map_Ke`, `map_Pr`, `bump`, `norm`, …).
+fn is_texture_statement(keyword: &str) -> bool {
+    keyword.starts_with("map_") || ["bump", "norm", "disp", "decal", "refl"].contains(&keyword)
+}
+
+/// Every name the value of a statement whose keyword (lowercased) `keyword` accepts may stand
+/// for: each run of consecutive words of the value (each run for values of at most 16 words,
+/// else each word and each run of last words). A list of names (`mtllib a.mtl b.mtl`), a name
+/// with spaces and a name after options (`map_Kd -s 1 1 1 wood.png`) are all among them;
+/// guarding more names than the loader reads is harmless.
+fn names_after(text: &str, keyword: impl Fn(&str) -> bool) -> Vec<String> {
+    let mut names = Vec::new();
+    for line in text.lines() {
+        let mut words = line.split_whitespace();
+        let Some(first) = words.next() else {
+            continue;
+        };
+        if !keyword(&first.to_ascii_lowercase()) {
+            continue;
+        }
+        let words: Vec<&str> = words.collect();
+        let n = words.len();
+        for start in 0..n {
+            for end in start + 1..=n {
+                if n <= 16 || end == start + 1 || end == n {
+                    names.push(words[start..end].join(" "));
+                }
             }
-        })
-        .collect()
+        }
+    }
+    names
 }
 
 fn percent_decode(uri: &str) -> String {
@@ -234,6 +254,42 @@ mod tests {
         let mut g2 = OutputGuard::default();
         g2.add(&d.join("afile/x.png")).unwrap();
         assert!(g2.create_folders().is_err());
+        std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// Several libraries after one `mtllib`, names with spaces, UTF-16 text and every texture
+    /// statement the loader reads are guarded.
+    #[test]
+    fn obj_inputs_include_every_library_and_map_the_loader_reads() {
+        let d = tmp("obj-exported");
+        let obj = "mtllib a.mtl other.mtl\nmtllib b c.mtl\nv 0 0 0\n";
+        let mut utf16 = vec![0xff, 0xfe];
+        utf16.extend(obj.encode_utf16().flat_map(u16::to_le_bytes));
+        std::fs::write(d.join("m.obj"), utf16).unwrap();
+        std::fs::write(
+            d.join("a.mtl"),
+            "newmtl a\nmap_Ke glow.png\nnorm -bm 0.5 n.png\n",
+        )
+        .unwrap();
+        std::fs::write(
+            d.join("b c.mtl"),
+            "newmtl b\nmap_Pr rough map.png\nmap_Pm -imfchan b m.png\n",
+        )
+        .unwrap();
+        let files = input_files(&Input::File(d.join("m.obj"), Default::default()));
+        for name in [
+            "a.mtl",
+            "b c.mtl",
+            "glow.png",
+            "n.png",
+            "rough map.png",
+            "m.png",
+        ] {
+            assert!(
+                files.contains(&d.join(name)),
+                "{name} is not guarded: {files:?}"
+            );
+        }
         std::fs::remove_dir_all(&d).unwrap();
     }
 

@@ -314,6 +314,14 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
     }
 }
 
+/// OBJ or MTL text as the OBJ loader reads it: UTF-16 with a byte-order mark, UTF-8 (a
+/// byte-order mark dropped), else Latin-1; lines ending in `\` joined with the next. For tools
+/// that look into these files as the loader does (the command's guard against overwriting an
+/// input).
+pub fn obj_text(bytes: &[u8]) -> String {
+    obj_text::text(bytes)
+}
+
 /// Names and one-line descriptions of the built-in scenes.
 pub fn builtin_scenes() -> &'static [(&'static str, &'static str)] {
     builtin::SCENES
