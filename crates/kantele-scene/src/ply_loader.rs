@@ -26,27 +26,14 @@ use ply_rs_bw::ply::{
 use crate::budget::{vec_with_capacity, Budget};
 use crate::ear_clip::triangulate_faces;
 use crate::mesh_util::{first_index_out_of_range, flat_normals};
-use crate::read_policy::read_regular_file;
-use crate::single_mesh::{mesh_name, single_mesh_scene};
+use crate::single_mesh::load_single_mesh;
 use crate::{one_line, LoadError, LoadOptions, LoadedScene, SceneInfo};
 
 /// Loads a `.ply` file.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
-    std::fs::metadata(path).map_err(|source| LoadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let mut budget = Budget::new(options.max_memory);
-    let bytes = read_regular_file(path, &mut budget).map_err(|e| LoadError::invalid(path, e))?;
-    let mut info = SceneInfo {
-        source: path.display().to_string(),
-        node_count: 1,
-        ..SceneInfo::default()
-    };
-    let mesh = read_mesh(&bytes, mesh_name(path), &mut budget, &mut info)
-        .map_err(|e| LoadError::invalid(path, e))?;
-    drop(bytes);
-    single_mesh_scene(path, mesh, info, options, budget)
+    load_single_mesh(path, options, |bytes, name, budget, info| {
+        read_mesh(&bytes, name, budget, info)
+    })
 }
 
 /// The mesh of a PLY file's bytes (its material is left at 0).

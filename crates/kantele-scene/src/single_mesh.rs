@@ -10,6 +10,7 @@ use kantele_rules::scene::{Draw, Light, Material, Mesh, Scene, Shading};
 
 use crate::budget::Budget;
 use crate::mesh_util::framing_camera;
+use crate::read_policy::read_regular_file;
 use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
 
 /// Linear base colour of the material of a mesh without vertex colours: a light grey (sRGB
@@ -47,6 +48,30 @@ pub(crate) fn face_normals(positions: &[Vec3]) -> Vec<Vec3> {
 /// The scene of `mesh`, the only mesh of the file at `path` (its `material` is set here):
 /// drawn once at the origin, framed by a made-up camera, lit by the headlight. A mesh without
 /// primitives draws nothing (with a warning).
+/// Loads a file holding one mesh (PLY, STL): reads it under the read policy and the budget,
+/// hands its bytes, its name and the budget to `read_mesh` (whose error becomes a one-line
+/// error naming the file), and makes the scene of [`single_mesh_scene`].
+pub(crate) fn load_single_mesh(
+    path: &Path,
+    options: &LoadOptions,
+    read_mesh: impl FnOnce(Vec<u8>, String, &mut Budget, &mut SceneInfo) -> Result<Mesh, String>,
+) -> Result<LoadedScene, LoadError> {
+    std::fs::metadata(path).map_err(|source| LoadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut budget = Budget::new(options.max_memory);
+    let bytes = read_regular_file(path, &mut budget).map_err(|e| LoadError::invalid(path, e))?;
+    let mut info = SceneInfo {
+        source: path.display().to_string(),
+        node_count: 1,
+        ..SceneInfo::default()
+    };
+    let mesh = read_mesh(bytes, mesh_name(path), &mut budget, &mut info)
+        .map_err(|e| LoadError::invalid(path, e))?;
+    single_mesh_scene(path, mesh, info, options, budget)
+}
+
 pub(crate) fn single_mesh_scene(
     path: &Path,
     mut mesh: Mesh,

@@ -17,8 +17,7 @@ use glam::Vec3;
 use kantele_rules::scene::{Mesh, Topology};
 
 use crate::budget::{vec_with_capacity, Budget};
-use crate::read_policy::read_regular_file;
-use crate::single_mesh::{face_normals, mesh_name, single_mesh_scene};
+use crate::single_mesh::{face_normals, load_single_mesh};
 use crate::{one_line, LoadError, LoadOptions, LoadedScene, SceneInfo};
 
 /// Bytes of a binary STL header: 80 free bytes and the triangle count.
@@ -37,20 +36,7 @@ const MESH_BYTES_PER_TRIANGLE: u64 = 3 * (12 + 12 + 4);
 
 /// Loads an `.stl` file.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
-    std::fs::metadata(path).map_err(|source| LoadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let mut budget = Budget::new(options.max_memory);
-    let bytes = read_regular_file(path, &mut budget).map_err(|e| LoadError::invalid(path, e))?;
-    let mut info = SceneInfo {
-        source: path.display().to_string(),
-        node_count: 1,
-        ..SceneInfo::default()
-    };
-    let mesh = read_mesh(bytes, mesh_name(path), &mut budget, &mut info)
-        .map_err(|e| LoadError::invalid(path, e))?;
-    single_mesh_scene(path, mesh, info, options, budget)
+    load_single_mesh(path, options, read_mesh)
 }
 
 /// How an STL file is encoded.

@@ -25,6 +25,28 @@ pub(super) struct UvMap {
     pub(super) transform: Mat3,
 }
 
+/// A texture reference read from extension JSON (`{"index", "texCoord", "extensions":
+/// {"KHR_texture_transform"}}`): the file's texture and the coordinates it reads; `None` when
+/// `index` names no texture of `document`.
+pub(super) fn json_texture_reference<'a>(
+    document: &'a gltf::Document,
+    info: &serde_json::Value,
+) -> Option<(gltf::texture::Texture<'a>, UvMap)> {
+    let texture = info
+        .get("index")
+        .and_then(serde_json::Value::as_u64)
+        .and_then(|i| document.textures().nth(usize::try_from(i).ok()?))?;
+    let tex_coord = info
+        .get("texCoord")
+        .and_then(serde_json::Value::as_u64)
+        .and_then(|t| u32::try_from(t).ok())
+        .unwrap_or(0);
+    let transform = info
+        .get("extensions")
+        .and_then(|e| e.get("KHR_texture_transform"));
+    Some((texture, UvMap::of(tex_coord, transform)))
+}
+
 impl UvMap {
     /// The map of a texture reference: its `texCoord` and its `KHR_texture_transform`
     /// extension value, if any.
@@ -299,18 +321,21 @@ impl<'a> Loader<'a> {
         Ok(out)
     }
 
+    /// The glTF image `texture` shows (as patching the JSON found it), if any.
+    fn texture_image(&self, texture: &gltf::texture::Texture) -> Option<usize> {
+        self.patched
+            .texture_images
+            .get(texture.index())
+            .copied()
+            .flatten()
+    }
+
     fn texture_binding(
         &mut self,
         texture: &gltf::texture::Texture,
         color_space: ColorSpace,
     ) -> Result<Option<TextureBinding>, LoadError> {
-        let Some(image_index) = self
-            .patched
-            .texture_images
-            .get(texture.index())
-            .copied()
-            .flatten()
-        else {
+        let Some(image_index) = self.texture_image(texture) else {
             return Ok(None);
         };
         let texture_index = match self.image_textures.get(&(image_index, color_space)) {
@@ -339,13 +364,7 @@ impl<'a> Loader<'a> {
         texture: &gltf::texture::Texture,
         color_space: ColorSpace,
     ) -> Result<Option<SourceImage>, LoadError> {
-        let Some(image_index) = self
-            .patched
-            .texture_images
-            .get(texture.index())
-            .copied()
-            .flatten()
-        else {
+        let Some(image_index) = self.texture_image(texture) else {
             return Ok(None);
         };
         let loaded = match self.image_textures.get(&(image_index, color_space)) {

@@ -6,7 +6,7 @@ use glam::Vec3;
 use kantele_rules::shade::texture::ColorSpace;
 use serde_json::Value;
 
-use super::material::{TextureSlot, UvMap};
+use super::material::{json_texture_reference, TextureSlot, UvMap};
 use super::Loader;
 
 /// What the extensions give a material (the glTF defaults where it has none).
@@ -116,26 +116,13 @@ impl<'a> Loader<'a> {
             let Some(info) = extension.and_then(|e| e.get(key)) else {
                 continue;
             };
-            let texture = info
-                .get("index")
-                .and_then(Value::as_u64)
-                .and_then(|i| self.document.textures().nth(usize::try_from(i).ok()?));
-            let Some(texture) = texture else {
+            let Some((texture, uv)) = json_texture_reference(self.document, info) else {
                 self.info.warn(format!(
                     "material '{name}': the {} texture refers to no texture; it is left out",
                     slot.name()
                 ));
                 continue;
             };
-            let tex_coord = info
-                .get("texCoord")
-                .and_then(Value::as_u64)
-                .and_then(|t| u32::try_from(t).ok())
-                .unwrap_or(0);
-            let transform = info
-                .get("extensions")
-                .and_then(|e| e.get("KHR_texture_transform"));
-            let uv = UvMap::of(tex_coord, transform);
             out.textures.push((slot, texture, color_space, uv));
         }
         out

@@ -14,7 +14,7 @@ use kantele_rules::shade::spec_gloss::{to_metallic_roughness, SpecularGlossiness
 use kantele_rules::shade::texture::{ColorSpace, Sampler};
 use serde_json::Value;
 
-use super::material::{sampler_of, SourceImage, UvMap};
+use super::material::{json_texture_reference, sampler_of, SourceImage, UvMap};
 use super::Loader;
 use crate::spec_gloss_texels::{convert_textures, converted_size, Source, SpecGlossFactors};
 use crate::texture_util::{placeholder, ImageError};
@@ -259,29 +259,13 @@ impl<'a> Loader<'a> {
         key: &str,
     ) -> Option<TextureRef<'a>> {
         let info = extension.get(key)?;
-        let document = self.document;
-        let texture = info
-            .get("index")
-            .and_then(Value::as_u64)
-            .and_then(|i| document.textures().nth(usize::try_from(i).ok()?));
-        let Some(texture) = texture else {
+        let Some((texture, uv)) = json_texture_reference(self.document, info) else {
             self.info.warn(format!(
                 "material '{name}': {SPEC_GLOSS}: {key} names no texture of the file; left out"
             ));
             return None;
         };
-        let tex_coord = info
-            .get("texCoord")
-            .and_then(Value::as_u64)
-            .and_then(|t| u32::try_from(t).ok())
-            .unwrap_or(0);
-        let transform = info
-            .get("extensions")
-            .and_then(|e| e.get("KHR_texture_transform"));
-        Some(TextureRef {
-            texture,
-            uv: UvMap::of(tex_coord, transform),
-        })
+        Some(TextureRef { texture, uv })
     }
 }
 
