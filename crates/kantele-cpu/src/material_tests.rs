@@ -2,7 +2,6 @@
 
 use super::*;
 use crate::pipeline::{Indices, Renderer, RendererOptions};
-use kantele_lanes::Isa;
 use kantele_rules::scene::{Mesh, Topology};
 use kantele_rules::shade::texture::ColorSpace;
 
@@ -117,7 +116,7 @@ fn a_constant_vertex_colour_is_shaded_exactly() {
     );
     assert!(shader.untextured_color.is_some());
     let expected = color.to_array().map(f32::to_bits);
-    for isa in Isa::supported() {
+    for isa in crate::pipeline::compiled_supported() {
         let options = RendererOptions {
             isa: Some(isa),
             ..RendererOptions::default()
@@ -194,7 +193,7 @@ fn packed_rows_shade_as_rows_do() {
         (1, 1),
     );
     assert!(shader.opaque_textured().is_some());
-    for isa in Isa::supported() {
+    for isa in crate::pipeline::compiled_supported() {
         let options = RendererOptions {
             isa: Some(isa),
             ..RendererOptions::default()
@@ -365,7 +364,7 @@ fn scalar_fragments_and_lane_programs_take_the_same_normal_direction() {
             (1, 1),
         )
         .with_vertex_colors(vertex_colors);
-        for isa in Isa::supported() {
+        for isa in crate::pipeline::compiled_supported() {
             let options = RendererOptions {
                 isa: Some(isa),
                 ..RendererOptions::default()

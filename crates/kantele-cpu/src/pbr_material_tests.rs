@@ -6,7 +6,6 @@ use glam::{Vec3, Vec4};
 
 use super::*;
 use crate::pipeline::{Indices, Renderer, RendererOptions};
-use kantele_lanes::Isa;
 use kantele_rules::scene::{Mesh, Topology};
 use kantele_rules::setup::CullMode;
 use kantele_rules::shade::environment::EnvironmentLight;
@@ -171,7 +170,7 @@ fn lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time() {
     let reference = render(&shader, &mesh, RendererOptions::default());
     let covered = reference.iter().filter(|c| c[3] > 0.0).count();
     assert!(covered > 1500, "{covered} pixels");
-    for isa in Isa::supported() {
+    for isa in crate::pipeline::compiled_supported() {
         let options = RendererOptions {
             isa: Some(isa),
             ..RendererOptions::default()

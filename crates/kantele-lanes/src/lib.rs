@@ -291,33 +291,84 @@ pub trait LaneKernel {
 /// from [`Lanes::isa`] ([`Isa::Avx512`] runs the AVX2 lanes: see [`Isa::lanes`]).
 #[inline]
 pub fn dispatch<K: LaneKernel>(isa: Isa, kernel: K) -> K::Output {
+    dispatch_within::<EveryIsa, K>(isa, kernel)
+}
+
+/// A set of instruction-set levels for [`dispatch_within`]: each constant says whether that
+/// level's entry point is compiled. The scalar reference always is.
+///
+/// The constants are read where a kernel is instantiated, so a level left out is never
+/// compiled for that kernel: no machine code, no compile time.
+pub trait IsaSet {
+    /// [`Isa::Sse2`].
+    const SSE2: bool;
+    /// [`Isa::Sse41`].
+    const SSE41: bool;
+    /// [`Isa::Avx2`].
+    const AVX2: bool;
+    /// [`Isa::Avx512`].
+    const AVX512: bool;
+    /// [`Isa::Neon`].
+    const NEON: bool;
+
+    /// Whether `isa`'s entry point is compiled.
+    fn contains(isa: Isa) -> bool {
+        match isa {
+            Isa::Scalar => true,
+            Isa::Sse2 => Self::SSE2,
+            Isa::Sse41 => Self::SSE41,
+            Isa::Avx2 => Self::AVX2,
+            Isa::Avx512 => Self::AVX512,
+            Isa::Neon => Self::NEON,
+        }
+    }
+}
+
+/// Every level: the set [`dispatch`] compiles.
+#[derive(Clone, Copy, Debug)]
+pub struct EveryIsa;
+
+impl IsaSet for EveryIsa {
+    const SSE2: bool = true;
+    const SSE41: bool = true;
+    const AVX2: bool = true;
+    const AVX512: bool = true;
+    const NEON: bool = true;
+}
+
+/// [`dispatch`] with only the levels of `S` compiled: a level outside `S`, like one the CPU
+/// lacks, falls back to [`Isa::Scalar`].
+#[inline]
+pub fn dispatch_within<S: IsaSet, K: LaneKernel>(isa: Isa, kernel: K) -> K::Output {
+    // Each guard is a constant of `S` by itself, which the compiler resolves when it
+    // instantiates this function, before it generates code for the arm.
     match isa {
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => {
+        Isa::Avx512 if S::AVX512 => {
             if let Some(token) = Avx2::new().filter(|_| avx2::has_avx512()) {
                 return avx2::run_avx512(token, kernel);
             }
         }
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 => {
+        Isa::Avx2 if S::AVX2 => {
             if let Some(token) = Avx2::new() {
                 return avx2::run(token, kernel);
             }
         }
         #[cfg(target_arch = "x86_64")]
-        Isa::Sse41 => {
+        Isa::Sse41 if S::SSE41 => {
             if let Some(token) = Sse41::new() {
                 return sse2::run_sse41(token, kernel);
             }
         }
         #[cfg(target_arch = "x86_64")]
-        Isa::Sse2 => {
+        Isa::Sse2 if S::SSE2 => {
             if let Some(token) = Sse2::new() {
                 return run_out_of_line(token, kernel);
             }
         }
         #[cfg(target_arch = "aarch64")]
-        Isa::Neon => {
+        Isa::Neon if S::NEON => {
             if let Some(token) = Neon::new() {
                 return run_out_of_line(token, kernel);
             }

@@ -15,11 +15,12 @@ use super::shader::{
     constant_varyings, vertex_varyings, FragmentLanes, Interpolation, LaneProgram, LaneProgramJob,
     Shader,
 };
+use super::shading_isas::dispatch_shading;
 use crate::raster::bin::{TileBins, TriangleRef};
 use crate::raster::samples::SampleCoverage;
 use crate::raster::{rasterize_blocks, BlockCoverage, Strategy};
 use crate::rop::{BlendMode, BlockRows, DeferredClear, DepthFunc, Framebuffer, TileBuffer};
-use kantele_lanes::{dispatch, prefetch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8, MaskOf};
+use kantele_lanes::{prefetch, F32x8, I32x8, Isa, LaneKernel, Lanes, Mask8, MaskOf};
 use kantele_rules::fixed::pixel_center;
 use kantele_rules::setup::TriangleSetup;
 use kantele_rules::state::RenderState;
@@ -204,7 +205,7 @@ impl<S: Shader> LaneProgramJob for ShadeTriangleJob<'_, '_, S> {
             && state.blend == BlendMode::Replace;
         macro_rules! shade {
             ($opaque_less:literal, $constant:literal) => {
-                dispatch(
+                dispatch_shading(
                     self.isa,
                     ShadeTriangle::<S, P, $opaque_less, $constant> {
                         draw: self.draw,

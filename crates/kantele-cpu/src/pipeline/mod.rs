@@ -23,6 +23,7 @@ mod packed_rows;
 mod points_lines;
 mod sanitize;
 mod shader;
+mod shading_isas;
 mod warm;
 mod workers;
 
@@ -44,6 +45,9 @@ use self::budget::FrameBudget;
 use self::call::DrawCall;
 use self::draw::DrawJob;
 use self::geometry::{run_geometry, GeometryScratch};
+use self::shading_isas::compiled_level;
+#[cfg(test)]
+pub(crate) use self::shading_isas::compiled_supported;
 use self::warm::{WarmWorkers, WARM_AFTER_FRAME, WARM_WHILE_QUEUING};
 use crate::raster::bin::TileBins;
 use crate::raster::Strategy;
@@ -280,13 +284,14 @@ impl Renderer {
     }
 }
 
-/// The instruction set to use: the requested one when the CPU has it, else the selected one.
+/// The instruction set to use: the requested one when the CPU has it, else the selected one
+/// (as [`shading_isas::compiled_level`] compiles it).
 fn resolve_isa(requested: Option<Isa>) -> Isa {
-    match requested {
+    compiled_level(match requested {
         Some(isa) if isa.is_supported() => isa,
         Some(_) => Isa::Scalar,
         None => Isa::selected(),
-    }
+    })
 }
 
 fn check_target_size(width: u32, height: u32) -> Result<(), RenderError> {

@@ -23,11 +23,12 @@ use super::fragment::{
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
 use super::shader::{constant_varyings, vertex_varyings, FragmentLanes, Interpolation, Shader};
+use super::shading_isas::dispatch_shading;
 use crate::raster::bin::TileBins;
 use crate::raster::samples::{rasterize_samples, SampleCoverage, MAX_COVERAGE_PLANES};
 use crate::raster::Strategy;
 use crate::rop::{Framebuffer, TileBuffer};
-use kantele_lanes::{dispatch, F32x8, Isa, LaneKernel, Lanes, Mask8};
+use kantele_lanes::{F32x8, Isa, LaneKernel, Lanes, Mask8};
 use kantele_rules::fixed::{pixel_center, BLOCK_SIZE, TILE_SIZE};
 use kantele_rules::setup::TriangleSetup;
 
@@ -93,7 +94,7 @@ pub(super) fn shade_triangle_multisampled<S: Shader>(
     tile: &mut TileBuffer,
     isa: Isa,
 ) -> RasterCounters {
-    dispatch(
+    dispatch_shading(
         isa,
         ShadeSamples {
             draw,

@@ -10,6 +10,7 @@ mod common;
 
 mod bands;
 mod coverage;
+mod isa_scenes;
 mod multisample;
 mod pipeline;
 mod points_lines;

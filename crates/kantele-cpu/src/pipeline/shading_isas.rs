@@ -1,0 +1,59 @@
+//! The instruction sets the per-pixel shading kernels are compiled for.
+//!
+//! Every shading kernel is compiled once per instruction set, for every shader and lane program
+//! (the longest part of building this crate). The library compiles them for every level. This
+//! crate's own unit-test build compiles the scalar reference and one vector level (AVX2, or
+//! NEON on AArch64): it is compiled beside the library, and with every level it took as long
+//! as the library. The tests of the whole renderer over every level (`isa_identical` and the
+//! reference scenes under `KANTELE_ISA`) run the library's kernels, all of them.
+
+use kantele_lanes::{dispatch_within, Isa, IsaSet, LaneKernel};
+
+#[cfg(not(test))]
+type Compiled = kantele_lanes::EveryIsa;
+#[cfg(test)]
+type Compiled = UnitTestIsas;
+
+/// The levels of the unit-test build.
+#[cfg(test)]
+struct UnitTestIsas;
+
+#[cfg(test)]
+impl IsaSet for UnitTestIsas {
+    const SSE2: bool = false;
+    const SSE41: bool = false;
+    const AVX2: bool = true;
+    const AVX512: bool = false;
+    const NEON: bool = true;
+}
+
+/// Runs a shading kernel with `isa`, a level [`compiled_level`] gave.
+#[inline]
+pub(super) fn dispatch_shading<K: LaneKernel>(isa: Isa, kernel: K) -> K::Output {
+    debug_assert!(
+        Compiled::contains(isa),
+        "{isa}: shading kernels not compiled"
+    );
+    dispatch_within::<Compiled, K>(isa, kernel)
+}
+
+/// The level a renderer draws with when `isa` (supported by this CPU) is asked for: `isa`
+/// itself, except in the unit-test build, where a level whose kernels are not compiled gives
+/// the widest compiled level that runs the same lanes or fewer: AVX-512 runs the AVX2 lanes
+/// (same results, other encodings), SSE2 and SSE4.1 the scalar ones.
+pub(super) fn compiled_level(isa: Isa) -> Isa {
+    if Compiled::contains(isa) {
+        isa
+    } else if Compiled::contains(isa.lanes()) {
+        isa.lanes()
+    } else {
+        Isa::Scalar
+    }
+}
+
+/// Every level this CPU supports whose shading kernels are compiled: what tests that compare
+/// levels go over.
+#[cfg(test)]
+pub(crate) fn compiled_supported() -> impl Iterator<Item = Isa> {
+    Isa::supported().filter(|&isa| Compiled::contains(isa))
+}
