@@ -152,6 +152,26 @@ pub(crate) fn read_u32(
     read_generic(data, accessor, budget, what, 0, |b| component_u32(b, ty))
 }
 
+/// Reads a float `MAT4` accessor (inverse bind matrices): 16 column-major floats per element.
+pub(crate) fn read_mat4_f32(
+    data: &BufferData,
+    accessor: &gltf::Accessor,
+    budget: &mut Budget,
+    what: &str,
+) -> Result<Vec<f32>, String> {
+    if accessor.dimensions() != Dimensions::Mat4 || accessor.data_type() != DataType::F32 {
+        return Err(format!(
+            "{what}: {:?} {:?} accessor, not float MAT4",
+            accessor.data_type(),
+            accessor.dimensions()
+        ));
+    }
+    // Four-byte components: columns lie back to back, with no padding to skip.
+    read_elements(data, accessor, budget, what, 0.0, |b| {
+        component_f32(b, DataType::F32, false)
+    })
+}
+
 fn read_generic<T: Copy>(
     data: &BufferData,
     accessor: &gltf::Accessor,
@@ -160,13 +180,25 @@ fn read_generic<T: Copy>(
     zero: T,
     convert: impl Fn(&[u8]) -> T,
 ) -> Result<Vec<T>, String> {
-    let components = accessor.dimensions().multiplicity();
     if matches!(
         accessor.dimensions(),
         Dimensions::Mat2 | Dimensions::Mat3 | Dimensions::Mat4
     ) {
         return Err(format!("{what}: matrix accessors are not vertex data"));
     }
+    read_elements(data, accessor, budget, what, zero, convert)
+}
+
+/// Reads every element (components back to back) and applies the sparse part.
+fn read_elements<T: Copy>(
+    data: &BufferData,
+    accessor: &gltf::Accessor,
+    budget: &mut Budget,
+    what: &str,
+    zero: T,
+    convert: impl Fn(&[u8]) -> T,
+) -> Result<Vec<T>, String> {
+    let components = accessor.dimensions().multiplicity();
     let size = component_size(accessor.data_type());
     let element = components * size;
     let count = accessor.count();

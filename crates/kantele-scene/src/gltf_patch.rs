@@ -11,8 +11,8 @@ pub(crate) struct Patched {
     /// Per glTF texture: the image it shows (`EXT_texture_webp` first, then `source`), or
     /// `None` when it has none that can be decoded.
     pub texture_images: Vec<Option<usize>>,
-    /// Number of animations dropped (they are not played).
-    pub animations: usize,
+    /// The file's animations, taken out of the JSON (the loader reads the one it plays).
+    pub animations: Vec<Value>,
     /// Warnings to record.
     pub warnings: Vec<String>,
 }
@@ -33,10 +33,10 @@ pub(crate) fn patch(root: &mut Value) -> Result<Patched, String> {
         return Err("not a valid glTF file: the JSON is not an object".to_string());
     };
     let mut patched = Patched::default();
-    // Animations are not played: drop them, so channels the `gltf` crate cannot express
-    // (KHR_animation_pointer, unknown paths, missing nodes) cannot make the file invalid.
+    // Animations are read by the loader itself: taken out, so channels the `gltf` crate cannot
+    // express (KHR_animation_pointer, unknown paths, missing nodes) cannot make the file invalid.
     if let Some(Value::Array(list)) = object.remove("animations") {
-        patched.animations = list.len();
+        patched.animations = list;
     }
     // A scene without `nodes` is valid glTF (an empty scene); the crate requires the field.
     if let Some(Value::Array(scenes)) = object.get_mut("scenes") {
@@ -116,7 +116,7 @@ mod tests {
         )
         .unwrap();
         let p = patch(&mut v).unwrap();
-        assert_eq!(p.animations, 1);
+        assert_eq!(p.animations.len(), 1);
         assert!(v.get("animations").is_none());
         assert_eq!(v["scenes"][0]["nodes"], Value::Array(vec![]));
         assert_eq!(p.texture_images, vec![Some(0), Some(1), None]);

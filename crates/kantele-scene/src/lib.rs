@@ -67,6 +67,7 @@ mod stl_loader;
 pub mod texture_util;
 mod uri;
 
+pub use gltf_loader::{AnimationChoice, AnimationPlayer, PoseError};
 pub use mesh_util::flat_normals;
 
 /// Where the last panic that the loaders caught on this thread (one of a dependency's known
@@ -84,6 +85,9 @@ pub struct LoadedScene {
     pub scene: Scene,
     /// Facts about the source file.
     pub info: SceneInfo,
+    /// The animation chosen with [`LoadOptions::animation`], to pose the scene at other times
+    /// without reloading; `None` when none was chosen (always for formats other than glTF).
+    pub animation: Option<AnimationPlayer>,
 }
 
 /// Facts about a source file, for `kantele info` and the render sidecar.
@@ -107,8 +111,12 @@ pub struct SceneInfo {
     /// Width and height of each texture of the scene, as its image header declares them
     /// (also when textures were not decoded).
     pub texture_sizes: Vec<(u32, u32)>,
-    /// Features the file uses that are ignored (extensions, animations, skins, ...), once each.
+    /// Features the file uses that are ignored (extensions, unplayable animation channels,
+    /// ...), once each.
     pub ignored: Vec<String>,
+    /// Names of the file's animations, by index (`animation N` for one without a name); see
+    /// [`LoadOptions::animation`].
+    pub animations: Vec<String>,
 }
 
 impl SceneInfo {
@@ -236,6 +244,15 @@ pub struct LoadOptions {
     pub exposure: f32,
     /// Tone map of PBR scenes.
     pub tonemap: Tonemap,
+    /// The glTF animation to play (by index or name); `None` (default) draws the rest pose
+    /// (the file's node transforms and morph weights, skins applied). An animation the file
+    /// lacks is an error that lists those it has. The loaded scene's
+    /// [`LoadedScene::animation`] poses it at other times.
+    pub animation: Option<AnimationChoice>,
+    /// The time of [`LoadOptions::animation`] to pose the scene at, in seconds (default 0);
+    /// before the first key the first holds, after the last key the last. Ignored without an
+    /// animation; a NaN or infinite time is an error.
+    pub time: f32,
 }
 
 /// Which environment lights a PBR scene.
@@ -265,6 +282,8 @@ impl Default for LoadOptions {
             environment_rotation_degrees: 0.0,
             exposure: 0.0,
             tonemap: Tonemap::PbrNeutral,
+            animation: None,
+            time: 0.0,
         }
     }
 }

@@ -246,7 +246,11 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         &mut budget,
     )
     .map_err(|e| LoadError::invalid(path, e))?;
-    Ok(LoadedScene { scene, info })
+    Ok(LoadedScene {
+        scene,
+        info,
+        animation: None,
+    })
 }
 
 /// Adds a mesh and a draw for each group of `l` / `p` statements (or of the vertices of a file

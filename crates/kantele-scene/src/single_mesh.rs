@@ -119,7 +119,11 @@ pub(crate) fn single_mesh_scene(
         &mut budget,
     )
     .map_err(|e| LoadError::invalid(path, e))?;
-    Ok(LoadedScene { scene, info })
+    Ok(LoadedScene {
+        scene,
+        info,
+        animation: None,
+    })
 }
 
 /// The name of a file's mesh: its file name without the extension.

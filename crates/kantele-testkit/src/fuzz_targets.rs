@@ -3,7 +3,8 @@
 //!
 //! Each loads the fuzzer's bytes as a scene file in a private, otherwise empty folder (the read
 //! policy confines the scene to it) under a 64 MiB budget, and renders what loads at 32 × 32
-//! on the CPU backend. A load error is a valid outcome; a panic in Kantele's own code (also one
+//! on the CPU backend (`gltf` inputs with animations also with their first animation, posed
+//! again after loading). A load error is a valid outcome; a panic in Kantele's own code (also one
 //! the loader's panic net caught), an abort, a scene the loader accepts but the backend refuses,
 //! or a failed render is a defect.
 
@@ -14,7 +15,7 @@ use std::sync::Arc;
 use kantele::backend::{Backend, FrameView, Pass};
 use kantele::cpu::{CpuBackend, CpuOptions};
 
-use kantele_scene::{LoadError, LoadOptions, LoadedScene};
+use kantele_scene::{AnimationChoice, LoadError, LoadOptions, LoadedScene};
 
 /// Memory budget of a fuzzed load: small enough that no input can exhaust the fuzzer's memory
 /// within the budget's rules.
@@ -36,6 +37,32 @@ pub fn gltf(data: &[u8]) {
     std::fs::write(&scene, data).expect("write the fuzz input");
     let result = load(&scene);
     check_and_render(result);
+    if data.windows(10).any(|w| w == b"animations") {
+        check_and_render(load_animated(&scene, data));
+    }
+}
+
+/// Loads the scene with its first animation at a time taken from the input (0 to 10 s, and
+/// past the keys), then poses it again at another time: posing the scene it was loaded with at
+/// a finite time never fails.
+fn load_animated(scene: &Path, data: &[u8]) -> Result<LoadedScene, LoadError> {
+    let hash = data
+        .iter()
+        .fold(0u32, |h, &b| h.wrapping_mul(31).wrapping_add(u32::from(b)));
+    let time = (hash % 1000) as f32 / 100.0;
+    let options = LoadOptions {
+        max_memory: FUZZ_MAX_MEMORY,
+        animation: Some(AnimationChoice::Index(0)),
+        time,
+        ..LoadOptions::default()
+    };
+    let mut loaded = kantele_scene::load_scene_with(scene, &options)?;
+    if let Some(player) = loaded.animation.take() {
+        player
+            .pose(&mut loaded.scene, 10.0 - time)
+            .unwrap_or_else(|e| panic!("posing the scene it was loaded with failed: {e}"));
+    }
+    Ok(loaded)
 }
 
 /// The `obj` target: the bytes up to [`MTL_SEPARATOR`] as `scene.obj`, the rest as

@@ -60,7 +60,11 @@ pub fn build(name: &str) -> Option<LoadedScene> {
 fn finish(name: &str, scene: Scene, mut info: SceneInfo) -> LoadedScene {
     info.source = format!("builtin:{name}");
     info.node_count = scene.draws.len() + info.cameras.len() + info.lights.len();
-    LoadedScene { scene, info }
+    LoadedScene {
+        scene,
+        info,
+        animation: None,
+    }
 }
 
 #[cfg(test)]

@@ -1,11 +1,20 @@
 //! glTF 2.0 (`.gltf` with external or embedded data, `.glb`) by the reference-scene rules.
 
+mod animation;
 mod camera;
+mod clip;
 mod material;
 mod material_extensions;
+mod morph;
 mod nodes;
+mod pose;
 mod primitive;
+mod rig_builder;
+mod skin;
 mod spec_gloss;
+
+pub use clip::AnimationChoice;
+pub use pose::{AnimationPlayer, PoseError};
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -77,9 +86,6 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     for w in &patched.warnings {
         info.warn(w.clone());
     }
-    if patched.animations > 0 {
-        info.ignore("animations");
-    }
     let root: gltf::json::Root = serde_json::from_value(value)
         .map_err(|e| invalid(format!("not a valid glTF file: {e}")))?;
     let document = check_extensions(path, root, &mut info)?;
@@ -106,6 +112,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         material_uv: Vec::new(),
         reference_extras: false,
         clear_color_given: false,
+        rig: None,
     }
     .run()
 }
@@ -259,6 +266,8 @@ struct Loader<'a> {
     reference_extras: bool,
     /// The scene's extras give a clear colour.
     clear_color_given: bool,
+    /// What posing needs (skins, the chosen animation), when the file has either.
+    rig: Option<rig_builder::RigBuilder>,
 }
 
 impl Loader<'_> {

@@ -29,9 +29,7 @@ impl Loader<'_> {
             let converted = self.material(&material)?;
             self.scene.materials.push(converted);
         }
-        if document.skins().len() > 0 {
-            self.info.ignore("skins (meshes drawn in their bind pose)");
-        }
+        self.prepare_rig()?;
 
         let Some(gltf_scene) = document
             .default_scene()
@@ -42,6 +40,7 @@ impl Loader<'_> {
             return Ok(LoadedScene {
                 scene: self.scene,
                 info: self.info,
+                animation: None,
             });
         };
         self.extras(&gltf_scene);
@@ -50,10 +49,12 @@ impl Loader<'_> {
         let mut light = None;
         let mut visited = vec![false; document.nodes().len()];
         // Depth first, each node before its children, in file order.
-        let mut stack: Vec<(gltf::Node, Mat4)> =
-            gltf_scene.nodes().map(|n| (n, Mat4::IDENTITY)).collect();
+        let mut stack: Vec<(gltf::Node, Mat4, Option<usize>)> = gltf_scene
+            .nodes()
+            .map(|n| (n, Mat4::IDENTITY, None))
+            .collect();
         stack.reverse();
-        while let Some((node, parent)) = stack.pop() {
+        while let Some((node, parent, parent_index)) = stack.pop() {
             let index = node.index();
             if std::mem::replace(&mut visited[index], true) {
                 self.info.warn(format!(
@@ -61,6 +62,7 @@ impl Loader<'_> {
                 ));
                 continue;
             }
+            self.rig_visit(index, parent_index);
             let local = Mat4::from_cols_array_2d(&node.transform().matrix());
             let world = parent * local;
             if let Some(c) = self.camera(&node, world) {
@@ -71,6 +73,7 @@ impl Loader<'_> {
                 self.scene
                     .file_cameras
                     .push(NamedCamera { name, camera: c });
+                self.rig_camera(self.scene.file_cameras.len() - 1, index);
                 if camera.is_none() {
                     camera = Some(c);
                 }
@@ -84,6 +87,7 @@ impl Loader<'_> {
                                 to_light: world.transform_vector3(Vec3::Z).normalize_or_zero(),
                                 color,
                             });
+                            self.rig_directional(index);
                         }
                         LightKind::Directional
                     }
@@ -105,6 +109,7 @@ impl Loader<'_> {
                 };
                 if punctual.color.is_finite() && punctual.position.is_finite() {
                     self.scene.lights.push(punctual);
+                    self.rig_light(self.scene.lights.len() - 1, index);
                 } else {
                     self.info.warn(format!(
                         "light '{}' has a non-finite colour or position; left out",
@@ -113,52 +118,62 @@ impl Loader<'_> {
                 }
             }
             if let Some(mesh) = node.mesh() {
-                if node.skin().is_some() {
-                    self.info.ignore("skins (meshes drawn in their bind pose)");
-                }
                 // Default morph weights: the node's, else the mesh's (the rest pose).
                 let weights: Vec<f32> = node
                     .weights()
                     .or(mesh.weights())
                     .map(<[f32]>::to_vec)
                     .unwrap_or_default();
-                let instances = self.instances(&node, world)?;
+                let instances = self.instances(&node)?;
                 for primitive in mesh.primitives() {
                     let key = (
                         mesh.index(),
                         primitive.index(),
                         weights.iter().map(|w| w.to_bits()).collect::<Vec<u32>>(),
                     );
-                    let mesh_index = match self.primitive_meshes.get(&key) {
-                        Some(&m) => m,
-                        None => {
-                            let m = self.primitive(&mesh, &primitive, &weights)?;
-                            self.primitive_meshes.insert(key, m);
-                            m
+                    let (mesh_index, skinned) = if self.deformed(&node, &primitive) {
+                        let (m, skinned) = self.deformable_primitive(&node, &mesh, &primitive)?;
+                        (Some(m), skinned)
+                    } else {
+                        match self.primitive_meshes.get(&key) {
+                            Some(&m) => (m, false),
+                            None => {
+                                let m = self.primitive(&mesh, &primitive, &weights)?;
+                                self.primitive_meshes.insert(key, m);
+                                (m, false)
+                            }
                         }
                     };
                     if let Some(mesh_index) = mesh_index {
+                        let count = instances.as_ref().map_or(1, Vec::len);
                         self.budget
-                            .charge(instances.len() as u64, 128, "the draws of a node")
+                            .charge(count as u64, 128, "the draws of a node")
                             .map_err(|e| self.invalid(e))?;
-                        for &model in &instances {
+                        for i in 0..count {
+                            let instance = instances.as_ref().map(|list| list[i]);
+                            // Posing places skinned draws (see `pose`); until then, the node.
+                            let model = instance.map_or(world, |m| world * m);
                             self.scene.draws.push(Draw {
                                 mesh: mesh_index,
                                 model,
                                 node_name: node.name().unwrap_or_default().to_string(),
                                 node_index: index,
                             });
+                            self.rig_draw(self.scene.draws.len() - 1, index, instance, skinned)?;
                         }
                     }
                 }
             }
             let children: Vec<_> = node.children().collect();
             for child in children.into_iter().rev() {
-                stack.push((child, world));
+                stack.push((child, world, Some(index)));
             }
         }
 
         self.scene.light = light.unwrap_or(Light::Headlight);
+        let animation = self.finish_rig()?;
+        // The first file camera, as posed.
+        let camera = camera.and(self.scene.file_cameras.first().map(|c| c.camera));
         self.choose_shading()?;
         match camera {
             Some(camera) => {
@@ -176,14 +191,15 @@ impl Loader<'_> {
         Ok(LoadedScene {
             scene: self.scene,
             info: self.info,
+            animation,
         })
     }
 
-    /// The model matrices a node's mesh is drawn with: its world matrix, or one per instance of
-    /// `EXT_mesh_gpu_instancing` (world × the instance's TRS).
-    fn instances(&mut self, node: &gltf::Node, world: Mat4) -> Result<Vec<Mat4>, LoadError> {
+    /// The instance transforms of `EXT_mesh_gpu_instancing` a node's mesh is drawn with (each
+    /// drawn with world × the instance's TRS); `None` without instancing.
+    fn instances(&mut self, node: &gltf::Node) -> Result<Option<Vec<Mat4>>, LoadError> {
         let Some(ext) = node.extension_value("EXT_mesh_gpu_instancing") else {
-            return Ok(vec![world]);
+            return Ok(None);
         };
         let what = format!("node {} (EXT_mesh_gpu_instancing)", node.index());
         let attributes = ext.get("attributes").and_then(|a| a.as_object());
@@ -226,7 +242,7 @@ impl Loader<'_> {
         ];
         let mut known = counts.iter().flatten();
         let Some(&count) = known.next() else {
-            return Ok(vec![world]);
+            return Ok(None);
         };
         if known.any(|&c| c != count) {
             return Err(self.invalid(format!(
@@ -246,9 +262,9 @@ impl Loader<'_> {
             let s = scale
                 .as_ref()
                 .map_or(Vec3::ONE, |s| Vec3::from_slice(&s[3 * i..]));
-            models.push(world * Mat4::from_scale_rotation_translation(s, r, t));
+            models.push(Mat4::from_scale_rotation_translation(s, r, t));
         }
-        Ok(models)
+        Ok(Some(models))
     }
 
     /// Decides the shading model (see [`crate::LoadOptions::shading`]) and sets up what goes

@@ -5,7 +5,7 @@ use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use kantele_rules::scene::{Mesh, Topology};
 
-use super::{named, Loader};
+use super::{morph, named, Loader};
 use crate::accessor::{read_f32, read_u32, BufferData};
 use crate::mesh_util::{
     fan_to_list, first_index_out_of_range, flat_normals, line_strip_to_list, strip_to_list,
@@ -20,6 +20,28 @@ impl Loader<'_> {
         primitive: &gltf::Primitive,
         weights: &[f32],
     ) -> Result<Option<usize>, LoadError> {
+        let mut converted = self.primitive_mesh(mesh, primitive, weights)?;
+        if converted.normals.is_none() && converted.topology == Topology::Triangles {
+            // De-indexed: one vertex (position, normal, texcoord, colour) per corner.
+            let what = format!("mesh '{}' primitive {}", converted.name, primitive.index());
+            self.budget
+                .charge(converted.indices.len() as u64, 48, &what)
+                .map_err(|e| self.invalid(e))?;
+            flat_normals(&mut converted);
+        }
+        self.scene.meshes.push(converted);
+        Ok(Some(self.scene.meshes.len() - 1))
+    }
+
+    /// One primitive as a mesh with the given morph weights, indexed as in the file (lists),
+    /// without made-up normals: what [`Self::primitive`] adds to the scene, before flat
+    /// shading.
+    pub(super) fn primitive_mesh(
+        &mut self,
+        mesh: &gltf::Mesh,
+        primitive: &gltf::Primitive,
+        weights: &[f32],
+    ) -> Result<Mesh, LoadError> {
         let mesh_name = named(mesh.name(), "mesh", mesh.index());
         let what = format!("mesh '{mesh_name}' primitive {}", primitive.index());
         let mode = primitive.mode();
@@ -152,7 +174,7 @@ impl Loader<'_> {
         };
         let (mut positions, mut normals) = (positions, normals);
         for (target, &weight) in primitive.morph_targets().zip(weights) {
-            if weight == 0.0 || !weight.is_finite() {
+            if !morph::applies(weight) {
                 continue;
             }
             let mut apply = |accessor: Option<gltf::Accessor>,
@@ -164,9 +186,7 @@ impl Loader<'_> {
                     return Err(count_error(semantic, a.count()));
                 }
                 let deltas = read(semantic, &a).map_err(|e| LoadError::invalid(self.path, e))?;
-                for (v, d) in values.iter_mut().zip(deltas.chunks_exact(3)) {
-                    *v += weight * Vec3::from_slice(d);
-                }
+                morph::add_target(values, &deltas, weight);
                 Ok(())
             };
             apply(target.positions(), &mut positions, "morph target POSITION")?;
@@ -237,7 +257,7 @@ impl Loader<'_> {
                 "{what}: index {index} at position {position} is out of range for {n} vertices"
             )));
         }
-        let mut converted = Mesh {
+        Ok(Mesh {
             name: mesh_name,
             positions,
             normals,
@@ -246,15 +266,6 @@ impl Loader<'_> {
             indices,
             topology,
             material,
-        };
-        if converted.normals.is_none() && topology == Topology::Triangles {
-            // De-indexed: one vertex (position, normal, texcoord, colour) per corner.
-            self.budget
-                .charge(converted.indices.len() as u64, 48, &what)
-                .map_err(|e| self.invalid(e))?;
-            flat_normals(&mut converted);
-        }
-        self.scene.meshes.push(converted);
-        Ok(Some(self.scene.meshes.len() - 1))
+        })
     }
 }

@@ -206,6 +206,11 @@ fn write_seed_corpus() {
     quad.write_gltf_embedded(&gltf.join("seed-textured-quad.gltf"));
     cube_gltf().write_glb(&gltf.join("seed-builtin-cube.glb"));
     std::fs::write(gltf.join("seed-sparse-strip.gltf"), sparse_strip()).expect("write");
+    std::fs::write(
+        gltf.join("seed-skin-animation.gltf"),
+        crate::animation::fuzz_seed(),
+    )
+    .expect("write");
 
     let obj = corpus_dir("obj");
     std::fs::create_dir_all(&obj).expect("corpus dir");

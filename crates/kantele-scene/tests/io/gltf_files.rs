@@ -72,7 +72,7 @@ fn the_quad_scene_follows_the_rules() {
     let dir = temp_dir("rules");
     let path = dir.join("quad.glb");
     textured_quad().write_glb(&path);
-    let LoadedScene { scene, info } = load(&path);
+    let LoadedScene { scene, info, .. } = load(&path);
 
     assert_eq!(info.node_count, 4);
     assert_eq!(info.cameras, vec!["cam".to_string()]);
@@ -192,7 +192,7 @@ fn defaults_shared_meshes_flat_normals_and_normalized_attributes() {
     let dir = temp_dir("defaults");
     let path = dir.join("defaults.gltf");
     g.write_gltf_embedded(&path);
-    let LoadedScene { scene, info } = load(&path);
+    let LoadedScene { scene, info, .. } = load(&path);
 
     // Defaults: no camera (framing one), headlight, 800 × 600, ambient 0.1; without
     // `ambient` in the extras the file is drawn with PBR: no lights, so the studio, and the
@@ -300,7 +300,7 @@ fn camera_and_light_come_from_the_first_nodes_in_draw_order() {
     let dir = temp_dir("camera");
     let path = dir.join("cameras.glb");
     g.write_glb(&path);
-    let LoadedScene { scene, info } = load(&path);
+    let LoadedScene { scene, info, .. } = load(&path);
     assert!(info.camera_from_file);
     assert_eq!(info.cameras, vec!["first", "second", "ortho"]);
     assert_eq!(info.lights, vec!["light 0", "a", "b"]);

@@ -9,6 +9,7 @@
 #[path = "../common/mod.rs"]
 mod common;
 
+mod animation;
 mod bad_input;
 mod corpus;
 mod fuzz_replay;
