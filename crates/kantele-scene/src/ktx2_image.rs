@@ -64,7 +64,7 @@ impl<'a> Ktx2File<'a> {
     /// error for everything this loader does not decode (cube maps, arrays, 3D and 1D
     /// textures, other formats: the message names the format).
     fn parse(bytes: &'a [u8]) -> Result<Self, ImageError> {
-        let reader = ktx2::Reader::new(bytes)
+        let reader = caught("reader", || ktx2::Reader::new(bytes))?
             .map_err(|e| decode_error(format!("not a valid KTX2 file: {e}")))?;
         let header = reader.header();
         let (width, height) = (header.pixel_width, header.pixel_height);
@@ -189,19 +189,17 @@ impl<'a> Ktx2File<'a> {
     fn decode_rgba8(&self) -> Result<Vec<u8>, ImageError> {
         let pixels = self.width as usize * self.height as usize;
         let mut rgba = match self.content {
-            Content::Etc1s | Content::Uastc => {
-                let transcoder = basisu::Transcoder::new(self.reader.data()).map_err(|e| {
-                    decode_error(format!("cannot transcode KTX2: {}", basis_error(&e)))
-                })?;
+            Content::Etc1s | Content::Uastc => caught("transcoder", || {
+                let transcoder = basisu::Transcoder::new(self.reader.data())?;
                 if transcoder.is_video() {
-                    return Err(decode_error("the KTX2 file is a Basis Universal video"));
+                    return Ok(None);
                 }
                 transcoder
                     .transcode(0, basisu::TargetFormat::Rgba32, basisu::DecodeFlags::NONE)
-                    .map_err(|e| {
-                        decode_error(format!("cannot transcode KTX2: {}", basis_error(&e)))
-                    })?
-            }
+                    .map(Some)
+            })?
+            .map_err(|e| decode_error(format!("cannot transcode KTX2: {}", basis_error(&e))))?
+            .ok_or_else(|| decode_error("the KTX2 file is a Basis Universal video"))?,
             Content::Plain { channels } => {
                 let level = self
                     .reader
@@ -211,7 +209,8 @@ impl<'a> Ktx2File<'a> {
                 let inflated;
                 let texels = match self.reader.header().supercompression_scheme {
                     Some(_) => {
-                        inflated = inflate_zstd(level.data, level.uncompressed_byte_length)?;
+                        let size = level.uncompressed_byte_length;
+                        inflated = caught("Zstandard decoder", || inflate_zstd(level.data, size))??;
                         &inflated[..]
                     }
                     None => level.data,
@@ -250,6 +249,14 @@ fn inflate_zstd(compressed: &[u8], size: u64) -> Result<Vec<u8>, ImageError> {
     let mut out = vec![0; size as usize];
     decoder.read_exact(&mut out).map_err(|e| corrupt(&e))?;
     Ok(out)
+}
+
+/// Runs a dependency's code (`what`: the reader, the transcoder, the Zstandard decoder) with its
+/// panics caught: a known way such code fails on corrupt data, turned into a one-line error for
+/// this image instead of a failed load.
+fn caught<T>(what: &str, f: impl FnOnce() -> T) -> Result<T, ImageError> {
+    crate::quiet_panic::catch(f)
+        .map_err(|m| decode_error(format!("malformed KTX2 file (the {what} failed: {m})")))
 }
 
 /// Swaps rows top for bottom.
@@ -323,25 +330,18 @@ pub(crate) fn color_space_note(bytes: &[u8], color_space: ColorSpace) -> Option<
     })
 }
 
-/// Body of the `ktx2` fuzz target: decodes the bytes under a 64 MiB budget. An error is a valid
-/// outcome when it is one line; a panic in Kantele's own code, a decoded size other than the
-/// header's, or an error of several lines is a defect (a panic).
+/// Body of the `ktx2` fuzz target: reads the size and decodes the bytes under a 64 MiB budget.
+/// An error is a valid outcome when it is one line; a panic in Kantele's own code (also one
+/// that [`caught`] turned into an error), a decoded size other than the header's, or an error
+/// of several lines is a defect (a panic).
 pub(crate) fn fuzz(data: &[u8]) {
-    let mut budget = Budget::new(64 << 20);
-    let size = ktx2_size(data);
-    let decoded = crate::quiet_panic::catch(|| decode_ktx2(data, ColorSpace::Srgb, &mut budget));
-    match decoded {
-        Ok(Ok(texture)) => {
-            let (width, height) = size.unwrap_or_else(|_| panic!("decoded without a size"));
-            assert_eq!((texture.width(), texture.height()), (width, height));
-        }
-        Ok(Err(ImageError::Budget(message) | ImageError::Decode(message))) => {
-            assert!(
-                !message.contains('\n'),
-                "an error of several lines: {message}"
-            );
-        }
-        Err(message) => {
+    let check = |error: &ImageError| {
+        let (ImageError::Budget(message) | ImageError::Decode(message)) = error;
+        assert!(
+            !message.contains('\n'),
+            "an error of several lines: {message}"
+        );
+        if message.starts_with("malformed KTX2 file") {
             let file = crate::quiet_panic::last_caught_file().unwrap_or_default();
             let file = file.replace('\\', "/");
             assert!(
@@ -349,6 +349,18 @@ pub(crate) fn fuzz(data: &[u8]) {
                 "Kantele's own code panicked in {file}: {message}"
             );
         }
+    };
+    let size = ktx2_size(data);
+    if let Err(e) = &size {
+        check(e);
+    }
+    let mut budget = Budget::new(64 << 20);
+    match decode_ktx2(data, ColorSpace::Srgb, &mut budget) {
+        Ok(texture) => {
+            let size = size.unwrap_or_else(|e| panic!("decoded, but no size: {e:?}"));
+            assert_eq!((texture.width(), texture.height()), size);
+        }
+        Err(e) => check(&e),
     }
 }
 
