@@ -3,7 +3,8 @@
 //!
 //! The container is read and validated with the `ktx2` crate; Basis Universal data is
 //! transcoded by `basisu` (pure Rust, a port of the reference transcoder: a corrupt file is an
-//! error or at worst a panic that the loader's net catches, never a crash of the process).
+//! error or at worst a panic, caught and turned into this image's error, never a crash of the
+//! process).
 //! Before anything is transcoded the texture's size is checked against
 //! [`MAX_TEXTURE_SIZE`](kantele_rules::shade::texture::MAX_TEXTURE_SIZE) and its decoded
 //! memory charged to the load's budget, and every level size the transcoder would allocate from
