@@ -8,7 +8,8 @@ use serde_json::Value;
 /// Facts gathered while patching.
 #[derive(Debug, Default)]
 pub(crate) struct Patched {
-    /// Per glTF texture: the image it shows (`EXT_texture_webp` first, then `source`), or
+    /// Per glTF texture: the image it shows (`KHR_texture_basisu` first, then
+    /// `EXT_texture_webp`, then `source`), or
     /// `None` when it has none that can be decoded.
     pub texture_images: Vec<Option<usize>>,
     /// The file's animations, taken out of the JSON (the loader reads the one it plays).
@@ -71,15 +72,12 @@ pub(crate) fn patch(root: &mut Value) -> Result<Patched, String> {
     };
     if let Some(Value::Array(textures)) = object.get("textures") {
         for (t, texture) in textures.iter().enumerate() {
+            let basisu = index(texture.pointer("/extensions/KHR_texture_basisu/source"));
             let webp = index(texture.pointer("/extensions/EXT_texture_webp/source"));
             let source = index(texture.get("source"));
-            let chosen = webp.or(source);
+            let chosen = basisu.or(webp).or(source);
             if chosen.is_none() {
-                for (ext, what) in [
-                    ("KHR_texture_basisu", "KTX2 / Basis Universal"),
-                    ("EXT_texture_avif", "AVIF"),
-                    ("MSFT_texture_dds", "DDS"),
-                ] {
+                for (ext, what) in [("EXT_texture_avif", "AVIF"), ("MSFT_texture_dds", "DDS")] {
                     if texture.pointer(&format!("/extensions/{ext}")).is_some() {
                         return Err(format!(
                             "texture {t} uses {ext} ({what} images) without a fallback image, which this loader cannot decode"
@@ -108,7 +106,7 @@ mod tests {
     use super::*;
 
     #[test]
-    fn patches_valid_files_and_refuses_draco_and_basis() {
+    fn patches_valid_files_and_refuses_draco() {
         let mut v: Value = serde_json::from_str(
             r#"{"asset":{"version":"2.0"},"scenes":[{}],"animations":[{"channels":[{"target":{"path":"pointer"}}]}],
                 "images":[{"uri":"a.png"},{"uri":"b.webp"}],
@@ -129,12 +127,31 @@ mod tests {
         assert!(patch(&mut draco)
             .unwrap_err()
             .contains("KHR_draco_mesh_compression"));
-        let mut basis: Value = serde_json::from_str(
-            r#"{"images":[{"uri":"a.ktx2"}],"textures":[{"extensions":{"KHR_texture_basisu":{"source":0}}}]}"#,
+        let mut dds: Value = serde_json::from_str(
+            r#"{"images":[{"uri":"a.dds"}],"textures":[{"extensions":{"MSFT_texture_dds":{"source":0}}}]}"#,
         )
         .unwrap();
-        assert!(patch(&mut basis)
-            .unwrap_err()
-            .contains("KHR_texture_basisu"));
+        assert!(patch(&mut dds).unwrap_err().contains("MSFT_texture_dds"));
+    }
+
+    #[test]
+    fn basis_images_come_before_the_fallback() {
+        // The KTX2 image first, with or without a fallback in `source`.
+        let mut v: Value = serde_json::from_str(
+            r#"{"images":[{"uri":"a.png"},{"uri":"b.ktx2"}],
+                "textures":[{"source":0,"extensions":{"KHR_texture_basisu":{"source":1}}},
+                            {"extensions":{"KHR_texture_basisu":{"source":1}}},
+                            {"source":1}]}"#,
+        )
+        .unwrap();
+        let p = patch(&mut v).unwrap();
+        assert_eq!(p.texture_images, vec![Some(1), Some(1), Some(1)]);
+        assert!(p.warnings.is_empty());
+        // A KTX2 image index out of range is refused like any other.
+        let mut bad: Value = serde_json::from_str(
+            r#"{"images":[{"uri":"a.png"}],"textures":[{"source":0,"extensions":{"KHR_texture_basisu":{"source":5}}}]}"#,
+        )
+        .unwrap();
+        assert!(patch(&mut bad).unwrap_err().contains("image 5"));
     }
 }

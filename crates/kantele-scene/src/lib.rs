@@ -46,6 +46,7 @@ mod ear_clip;
 mod environment_file;
 mod gltf_loader;
 mod gltf_patch;
+mod ktx2_image;
 pub mod mesh_util;
 mod meshopt_views;
 mod mtl;
@@ -76,6 +77,14 @@ pub use mesh_util::flat_normals;
 #[doc(hidden)]
 pub fn last_caught_panic_file() -> Option<String> {
     quiet_panic::last_caught_file()
+}
+
+/// Body of the `ktx2` fuzz target (`fuzz/fuzz_targets/ktx2.rs`): decodes the bytes as a KTX2
+/// image under a 64 MiB budget and panics on a defect (a panic in Kantele's own code, a texture
+/// of another size than the header's, an error of several lines); not a public API.
+#[doc(hidden)]
+pub fn fuzz_ktx2(data: &[u8]) {
+    ktx2_image::fuzz(data);
 }
 
 /// A loaded scene with what a user checks before rendering it.

@@ -44,13 +44,16 @@ fn reader<'a>(
 
 /// The image's size from its header alone (nothing is decoded).
 pub(crate) fn image_size(bytes: &[u8], mime_type: Option<&str>) -> Result<(u32, u32), ImageError> {
+    if crate::ktx2_image::is_ktx2(bytes, mime_type) {
+        return crate::ktx2_image::ktx2_size(bytes);
+    }
     reader(bytes, mime_type)?
         .into_dimensions()
         .map_err(|e| ImageError::Decode(format!("cannot decode image: {e}")))
 }
 
-/// Decodes an encoded PNG, JPEG or WebP image into a texture with its mip chain whose texels
-/// are encoded in `color_space` (sRGB for colours, linear for data such as normals,
+/// Decodes an encoded PNG, JPEG, WebP or KTX2 image into a texture with its mip chain whose
+/// texels are encoded in `color_space` (sRGB for colours, linear for data such as normals,
 /// metallic-roughness and occlusion), after reading its size from the header and charging the
 /// texture's memory to `budget`. The format is recognised from the data, `mime_type` is the
 /// fallback.
@@ -60,6 +63,9 @@ pub(crate) fn decode_within(
     color_space: ColorSpace,
     budget: &mut Budget,
 ) -> Result<Texture, ImageError> {
+    if crate::ktx2_image::is_ktx2(bytes, mime_type) {
+        return crate::ktx2_image::decode_ktx2(bytes, color_space, budget);
+    }
     let (width, height) = image_size(bytes, mime_type)?;
     let max = kantele_rules::shade::texture::MAX_TEXTURE_SIZE;
     if width == 0 || height == 0 || width > max || height > max {

@@ -466,6 +466,9 @@ impl<'a> Loader<'a> {
                 size,
             }));
         }
+        if let Some(note) = crate::ktx2_image::color_space_note(&bytes, color_space) {
+            self.info.warn(format!("{what}: {note}"));
+        }
         match decode_within(&bytes, mime_type.as_deref(), color_space, &mut self.budget) {
             Ok(texture) => Ok(Some(ReadImage::Decoded {
                 texture: Box::new(texture),

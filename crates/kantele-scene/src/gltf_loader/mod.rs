@@ -43,13 +43,13 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "EXT_mesh_gpu_instancing",
     "EXT_texture_webp",
     "EXT_meshopt_compression",
+    "KHR_texture_basisu",
 ];
 
 /// Extensions that change how geometry or images are stored and that this loader cannot decode:
 /// requiring one is an error (using one without requiring it is refused where it is used).
 const UNREADABLE_EXTENSIONS: &[&str] = &[
     "KHR_draco_mesh_compression",
-    "KHR_texture_basisu",
     "EXT_texture_avif",
     "MSFT_texture_dds",
 ];

@@ -1,6 +1,7 @@
 //! The fuzz targets on stable: every committed corpus file under `fuzz/corpus/<target>/`, then
 //! deterministic pseudo-random mutations of them, through the same bodies `cargo fuzz` runs
-//! (`kantele::fuzz_targets`, `kantele_testkit::fuzz_targets`). A defect panics, failing the test.
+//! (`kantele::fuzz_targets`, `kantele_testkit::fuzz_targets`, `kantele_scene::fuzz_ktx2`). A
+//! defect panics, failing the test.
 //!
 //! The seed files are generated, not hand-edited: `cargo test -p kantele-scene --test io
 //! -- --ignored write_seed_corpus` writes them (inputs the fuzzer found stay as they are).
@@ -182,6 +183,11 @@ fn stl_corpus_and_mutations() {
 }
 
 #[test]
+fn ktx2_corpus_and_mutations() {
+    replay("ktx2", 0x6a09_e667_f3bc_c908, kantele_scene::fuzz_ktx2);
+}
+
+#[test]
 fn raster_corpus_and_mutations() {
     replay(
         "raster",
@@ -228,6 +234,19 @@ fn write_seed_corpus() {
     std::fs::create_dir_all(&stl).expect("corpus dir");
     for (name, bytes) in crate::common::ply_stl::stl_fuzz_seeds() {
         std::fs::write(stl.join(name), bytes).expect("write");
+    }
+
+    // ktx2: the KTX2 test images (ETC1S with mip levels, ETC1S with alpha, UASTC with
+    // Zstandard; tests/data/ktx2/README.md).
+    let ktx2 = corpus_dir("ktx2");
+    std::fs::create_dir_all(&ktx2).expect("corpus dir");
+    let images = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/ktx2");
+    for name in [
+        "quadrants-etc1s.ktx2",
+        "quadrants-etc1s-alpha.ktx2",
+        "quadrants-uastc-zstd.ktx2",
+    ] {
+        std::fs::copy(images.join(name), ktx2.join(format!("seed-{name}"))).expect("copy");
     }
 
     // raster: width/height exponents, mode, strategy, then six little-endian u32 coordinates.

@@ -1,6 +1,6 @@
 //! Integration tests of `kantele-scene`: glTF, OBJ, PLY and STL loading (valid, bad and hostile
-//! files, the real-world corpus), fuzz replay, poses, the reference scenes and ISA-identical
-//! pictures.
+//! files, the real-world corpus, KTX2 textures), fuzz replay, poses, the reference scenes and
+//! ISA-identical pictures.
 //!
 //! One test binary with a module per subject: a binary per file would compile the shared
 //! generic code and link every dependency into each (in a clean build, 31 test binaries took a
@@ -16,6 +16,7 @@ mod fuzz_replay;
 mod gltf_files;
 mod hostile_files;
 mod isa_identical;
+mod ktx2_files;
 mod obj_files;
 mod obj_materials;
 mod ply_stl_files;

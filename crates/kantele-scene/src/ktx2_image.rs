@@ -1,0 +1,370 @@
+//! KTX2 images (`KHR_texture_basisu`, or a KTX2 file wherever a PNG could be): Basis Universal
+//! ETC1S and UASTC LDR transcoded to RGBA8, and the uncompressed 8-bit RGB / RGBA formats.
+//!
+//! The container is read and validated with the `ktx2` crate; Basis Universal data is
+//! transcoded by `basisu` (pure Rust, a port of the reference transcoder: a corrupt file is an
+//! error or at worst a panic, caught and turned into this image's error, never a crash of the
+//! process).
+//! Before anything is transcoded the texture's size is checked against
+//! [`MAX_TEXTURE_SIZE`](kantele_rules::shade::texture::MAX_TEXTURE_SIZE) and its decoded
+//! memory charged to the load's budget, and every level size the transcoder would allocate from
+//! the file is checked against the size the header implies.
+//!
+//! Level 0 is decoded; the texture builds its own mip chain from it (a [`Texture`] cannot take
+//! levels from a file), so the file's smaller levels are not read.
+
+use kantele_rules::shade::texture::{ColorSpace, Texture, MAX_TEXTURE_SIZE};
+use ktx2::{Format, SupercompressionScheme, TransferFunction};
+
+use crate::budget::Budget;
+use crate::texture_util::{ImageError, TEXTURE_BYTES_PER_TEXEL};
+
+/// The 12 bytes a KTX2 file starts with.
+const KTX2_MAGIC: [u8; 12] = [
+    0xAB, b'K', b'T', b'X', b' ', b'2', b'0', 0xBB, b'\r', b'\n', 0x1A, b'\n',
+];
+
+/// Bytes per texel the transcoder needs besides its RGBA8 output: the Zstandard-inflated level
+/// of UASTC (one byte a texel) and the per-block indices of ETC1S (a quarter byte a texel each
+/// for colour and alpha), rounded up.
+const TRANSCODER_SCRATCH_PER_TEXEL: u64 = 2;
+
+/// Whether `bytes` are to be read as a KTX2 file: they start with the KTX2 identifier, or they
+/// are declared `image/ktx2` and are no other image format the loader knows (the data decides
+/// first, as for the other formats: files often declare the wrong MIME type).
+pub(crate) fn is_ktx2(bytes: &[u8], mime_type: Option<&str>) -> bool {
+    bytes.starts_with(&KTX2_MAGIC)
+        || (mime_type == Some("image/ktx2") && image::guess_format(bytes).is_err())
+}
+
+/// What the KTX2 file holds, as far as decoding is concerned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Content {
+    /// Basis Universal ETC1S (BasisLZ supercompression).
+    Etc1s,
+    /// Basis Universal UASTC LDR, plain or Zstandard-supercompressed.
+    Uastc,
+    /// Uncompressed 8-bit texels with this many channels (3: RGB, 4: RGBA).
+    Plain { channels: u32 },
+}
+
+/// A validated KTX2 file: its header facts, ready to decode.
+struct Ktx2File<'a> {
+    reader: ktx2::Reader<&'a [u8]>,
+    content: Content,
+    width: u32,
+    height: u32,
+}
+
+fn decode_error(message: impl Into<String>) -> ImageError {
+    ImageError::Decode(message.into())
+}
+
+impl<'a> Ktx2File<'a> {
+    /// Parses and validates the header, the level index and the data format descriptor; an
+    /// error for everything this loader does not decode (cube maps, arrays, 3D and 1D
+    /// textures, other formats: the message names the format).
+    fn parse(bytes: &'a [u8]) -> Result<Self, ImageError> {
+        let reader = caught("reader", || ktx2::Reader::new(bytes))?
+            .map_err(|e| decode_error(format!("not a valid KTX2 file: {e}")))?;
+        let header = reader.header();
+        let (width, height) = (header.pixel_width, header.pixel_height);
+        if header.pixel_depth > 0 {
+            return Err(decode_error("the KTX2 file is a 3D texture"));
+        }
+        if header.face_count != 1 {
+            return Err(decode_error("the KTX2 file is a cube map"));
+        }
+        if header.layer_count > 1 {
+            return Err(decode_error(format!(
+                "the KTX2 file is an array of {} textures",
+                header.layer_count
+            )));
+        }
+        if width == 0 || height == 0 || width > MAX_TEXTURE_SIZE || height > MAX_TEXTURE_SIZE {
+            return Err(decode_error(format!(
+                "KTX2 image size {width}x{height} is outside 1..={MAX_TEXTURE_SIZE}"
+            )));
+        }
+        let scheme = header.supercompression_scheme;
+        let model = reader.color_model();
+        let content = match (header.format, model, scheme) {
+            (None, Some(ktx2::ColorModel::ETC1S), Some(SupercompressionScheme::BasisLZ)) => {
+                Content::Etc1s
+            }
+            (None, Some(ktx2::ColorModel::UASTC), None | Some(SupercompressionScheme::Zstandard)) => {
+                Content::Uastc
+            }
+            (None, model, _) => {
+                return Err(decode_error(format!(
+                    "KTX2 colour model {} with supercompression {} is not supported (Basis Universal ETC1S and UASTC are)",
+                    model.map_or("none".to_string(), |m| format!("{m:?}")),
+                    scheme_name(scheme),
+                )))
+            }
+            (Some(format), _, _) => {
+                let channels = match format {
+                    Format::R8G8B8A8_UNORM | Format::R8G8B8A8_SRGB => 4,
+                    Format::R8G8B8_UNORM | Format::R8G8B8_SRGB => 3,
+                    other => {
+                        return Err(decode_error(format!(
+                            "KTX2 format {other:?} is not supported (Basis Universal and 8-bit RGB / RGBA are)"
+                        )))
+                    }
+                };
+                if !matches!(scheme, None | Some(SupercompressionScheme::Zstandard)) {
+                    return Err(decode_error(format!(
+                        "KTX2 supercompression {} of {format:?} is not supported",
+                        scheme_name(scheme)
+                    )));
+                }
+                Content::Plain { channels }
+            }
+        };
+        let file = Self {
+            reader,
+            content,
+            width,
+            height,
+        };
+        file.check_level0()?;
+        Ok(file)
+    }
+
+    /// Level 0's bytes once decompressed, as the header implies them (`None` for ETC1S, whose
+    /// size is not fixed).
+    fn level0_size(&self) -> Option<u64> {
+        let (w, h) = (u64::from(self.width), u64::from(self.height));
+        match self.content {
+            Content::Etc1s => None,
+            Content::Uastc => Some(w.div_ceil(4) * h.div_ceil(4) * 16),
+            Content::Plain { channels } => Some(w * h * u64::from(channels)),
+        }
+    }
+
+    /// Checks level 0's recorded sizes against the header: the transcoder allocates a
+    /// Zstandard level's recorded uncompressed size as it is, so a wrong one is refused here.
+    fn check_level0(&self) -> Result<(), ImageError> {
+        let level = self
+            .reader
+            .levels()
+            .next()
+            .ok_or_else(|| decode_error("the KTX2 file has no image levels"))?;
+        let Some(expected) = self.level0_size() else {
+            return Ok(());
+        };
+        let zstd = self.reader.header().supercompression_scheme.is_some();
+        let (what, actual) = if zstd {
+            ("decompressed", level.uncompressed_byte_length)
+        } else {
+            ("stored", level.data.len() as u64)
+        };
+        if actual != expected {
+            return Err(decode_error(format!(
+                "KTX2 level 0 holds {actual} {what} bytes, but a {}x{} image needs {expected}",
+                self.width, self.height
+            )));
+        }
+        Ok(())
+    }
+
+    /// The colour space the file declares (its DFD transfer function), if it declares one.
+    fn declared_color_space(&self) -> Option<ColorSpace> {
+        match self.reader.transfer_function()? {
+            TransferFunction::SRGB => Some(ColorSpace::Srgb),
+            TransferFunction::Linear => Some(ColorSpace::Linear),
+            _ => None,
+        }
+    }
+
+    /// Whether rows are stored bottom first (`KTXorientation` `ru`); glTF and the loader's
+    /// textures want the top row first (`rd`, the default).
+    fn bottom_up(&self) -> bool {
+        self.reader
+            .key_value_data()
+            .find(|(key, _)| *key == "KTXorientation")
+            .is_some_and(|(_, value)| value.get(1) == Some(&b'u'))
+    }
+
+    /// Level 0 as RGBA8, rows top first.
+    fn decode_rgba8(&self) -> Result<Vec<u8>, ImageError> {
+        let pixels = self.width as usize * self.height as usize;
+        let mut rgba = match self.content {
+            Content::Etc1s | Content::Uastc => caught("transcoder", || {
+                let transcoder = basisu::Transcoder::new(self.reader.data())?;
+                if transcoder.is_video() {
+                    return Ok(None);
+                }
+                transcoder
+                    .transcode(0, basisu::TargetFormat::Rgba32, basisu::DecodeFlags::NONE)
+                    .map(Some)
+            })?
+            .map_err(|e| decode_error(format!("cannot transcode KTX2: {}", basis_error(&e))))?
+            .ok_or_else(|| decode_error("the KTX2 file is a Basis Universal video"))?,
+            Content::Plain { channels } => {
+                let level = self
+                    .reader
+                    .levels()
+                    .next()
+                    .ok_or_else(|| decode_error("the KTX2 file has no image levels"))?;
+                let inflated;
+                let texels = match self.reader.header().supercompression_scheme {
+                    Some(_) => {
+                        let size = level.uncompressed_byte_length;
+                        inflated = caught("Zstandard decoder", || inflate_zstd(level.data, size))??;
+                        &inflated[..]
+                    }
+                    None => level.data,
+                };
+                match channels {
+                    4 => texels.to_vec(),
+                    _ => texels
+                        .chunks_exact(3)
+                        .flat_map(|c| [c[0], c[1], c[2], 255])
+                        .collect(),
+                }
+            }
+        };
+        if rgba.len() != pixels * 4 {
+            return Err(decode_error(format!(
+                "the KTX2 decoder gave {} bytes for a {}x{} image",
+                rgba.len(),
+                self.width,
+                self.height
+            )));
+        }
+        if self.bottom_up() {
+            flip_rows(&mut rgba, self.width as usize * 4);
+        }
+        Ok(rgba)
+    }
+}
+
+/// A Zstandard-supercompressed level inflated to exactly `size` bytes (checked against the
+/// header before, so within the budget).
+fn inflate_zstd(compressed: &[u8], size: u64) -> Result<Vec<u8>, ImageError> {
+    use std::io::Read;
+    let corrupt =
+        |e: &dyn std::fmt::Display| decode_error(format!("corrupt Zstandard level in KTX2: {e}"));
+    let mut decoder = ruzstd::StreamingDecoder::new(compressed).map_err(|e| corrupt(&e))?;
+    let mut out = vec![0; size as usize];
+    decoder.read_exact(&mut out).map_err(|e| corrupt(&e))?;
+    Ok(out)
+}
+
+/// Runs a dependency's code (`what`: the reader, the transcoder, the Zstandard decoder) with its
+/// panics caught: a known way such code fails on corrupt data, turned into a one-line error for
+/// this image instead of a failed load.
+fn caught<T>(what: &str, f: impl FnOnce() -> T) -> Result<T, ImageError> {
+    crate::quiet_panic::catch(f)
+        .map_err(|m| decode_error(format!("malformed KTX2 file (the {what} failed: {m})")))
+}
+
+/// Swaps rows top for bottom.
+fn flip_rows(rgba: &mut [u8], row_bytes: usize) {
+    let rows = rgba.len() / row_bytes.max(1);
+    for y in 0..rows / 2 {
+        let (top, bottom) = rgba.split_at_mut((rows - 1 - y) * row_bytes);
+        top[y * row_bytes..(y + 1) * row_bytes].swap_with_slice(&mut bottom[..row_bytes]);
+    }
+}
+
+fn scheme_name(scheme: Option<SupercompressionScheme>) -> String {
+    scheme.map_or("none".to_string(), |s| format!("{s:?}"))
+}
+
+/// The transcoder's error in words.
+fn basis_error(error: &basisu::Error) -> String {
+    match error {
+        basisu::Error::Truncated => "the file is truncated".to_string(),
+        basisu::Error::InvalidData => "corrupt or unsupported Basis Universal data".to_string(),
+        other => format!("{other:?}"),
+    }
+}
+
+/// The size of a KTX2 image from its header (nothing is decoded).
+pub(crate) fn ktx2_size(bytes: &[u8]) -> Result<(u32, u32), ImageError> {
+    let file = Ktx2File::parse(bytes)?;
+    Ok((file.width, file.height))
+}
+
+/// Decodes level 0 of a KTX2 image into a texture whose texels are encoded in `color_space`
+/// (decided by the texture's use, as for every image), after charging the texture's memory and
+/// the transcoder's to `budget`.
+pub(crate) fn decode_ktx2(
+    bytes: &[u8],
+    color_space: ColorSpace,
+    budget: &mut Budget,
+) -> Result<Texture, ImageError> {
+    let file = Ktx2File::parse(bytes)?;
+    let (width, height) = (file.width, file.height);
+    budget
+        .charge(
+            u64::from(width) * u64::from(height),
+            TEXTURE_BYTES_PER_TEXEL + 4 + TRANSCODER_SCRATCH_PER_TEXEL,
+            &format!("a {width}x{height} KTX2 texture"),
+        )
+        .map_err(ImageError::Budget)?;
+    let rgba = file.decode_rgba8()?;
+    Texture::from_rgba8(width, height, &rgba, color_space)
+        .map_err(|e| ImageError::Decode(e.to_string()))
+}
+
+/// A note when a KTX2 image declares another colour space (its transfer function) than the one
+/// its use gives it; `None` for other images and when they agree.
+pub(crate) fn color_space_note(bytes: &[u8], color_space: ColorSpace) -> Option<String> {
+    if !is_ktx2(bytes, None) {
+        return None;
+    }
+    let declared = Ktx2File::parse(bytes).ok()?.declared_color_space()?;
+    (declared != color_space).then(|| {
+        let name = |c: ColorSpace| match c {
+            ColorSpace::Srgb => "sRGB",
+            ColorSpace::Linear => "linear",
+        };
+        format!(
+            "the KTX2 file declares {} texels, but the texture's use makes them {}; read as {}",
+            name(declared),
+            name(color_space),
+            name(color_space)
+        )
+    })
+}
+
+/// Body of the `ktx2` fuzz target: reads the size and decodes the bytes under a 64 MiB budget.
+/// An error is a valid outcome when it is one line; a panic in Kantele's own code (also one
+/// that [`caught`] turned into an error), a decoded size other than the header's, or an error
+/// of several lines is a defect (a panic).
+pub(crate) fn fuzz(data: &[u8]) {
+    let check = |error: &ImageError| {
+        let (ImageError::Budget(message) | ImageError::Decode(message)) = error;
+        assert!(
+            !message.contains('\n'),
+            "an error of several lines: {message}"
+        );
+        if message.starts_with("malformed KTX2 file") {
+            let file = crate::quiet_panic::last_caught_file().unwrap_or_default();
+            let file = file.replace('\\', "/");
+            assert!(
+                file.contains("/.cargo/") || file.contains("/rustc/") || !file.contains("kantele"),
+                "Kantele's own code panicked in {file}: {message}"
+            );
+        }
+    };
+    let size = ktx2_size(data);
+    if let Err(e) = &size {
+        check(e);
+    }
+    let mut budget = Budget::new(64 << 20);
+    match decode_ktx2(data, ColorSpace::Srgb, &mut budget) {
+        Ok(texture) => {
+            let size = size.unwrap_or_else(|e| panic!("decoded, but no size: {e:?}"));
+            assert_eq!((texture.width(), texture.height()), size);
+        }
+        Err(e) => check(&e),
+    }
+}
+
+#[cfg(test)]
+#[path = "ktx2_image_tests.rs"]
+mod tests;
