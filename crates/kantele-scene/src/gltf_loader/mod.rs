@@ -1,6 +1,7 @@
 //! glTF 2.0 (`.gltf` with external or embedded data, `.glb`) by the reference-scene rules.
 
 mod camera;
+mod catalogue;
 mod material;
 mod material_extensions;
 mod nodes;
@@ -34,6 +35,7 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "EXT_mesh_gpu_instancing",
     "EXT_texture_webp",
     "EXT_meshopt_compression",
+    "KHR_materials_variants",
 ];
 
 /// Extensions that change how geometry or images are stored and that this loader cannot decode:
@@ -73,6 +75,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     let mut value: serde_json::Value = serde_json::from_slice(&json)
         .map_err(|e| invalid(format!("not a valid glTF file: {e}")))?;
     drop(json);
+    // Read before patching, which drops the animations.
+    let animations = catalogue::read_animations(&value, &mut budget).map_err(invalid)?;
     let patched = patch(&mut value).map_err(invalid)?;
     for w in &patched.warnings {
         info.warn(w.clone());
@@ -96,6 +100,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         policy: &policy,
         budget,
         patched,
+        animations,
         scene: Scene::default(),
         info,
         image_textures: HashMap::new(),
@@ -239,6 +244,8 @@ struct Loader<'a> {
     budget: Budget,
     /// What patching the JSON found (the image each texture shows).
     patched: Patched,
+    /// The file's animations, for [`SceneInfo::animations`] (taken when listed).
+    animations: Vec<catalogue::AnimationTimes>,
     scene: Scene,
     info: SceneInfo,
     /// glTF image index → index into `scene.textures` (`None`: it could not be loaded).
