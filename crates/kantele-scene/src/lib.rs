@@ -8,9 +8,12 @@
 //! # Entry points
 //!
 //! - [`load_scene`] loads a file, choosing the format by extension. Malformed input of any kind
-//!   gives a [`LoadError`] that names the file, never a panic.
+//!   gives a [`LoadError`] that names the file, never a panic. [`load_scene_with`] loads under
+//!   [`LoadOptions`]: a memory budget and read policy, which scene and material variant of a
+//!   glTF file to draw, shading and a face-culling override.
 //! - [`builtin_scenes`] lists the built-in scenes (`cube`, `teapot`, `ground`, `pixel-edges`),
-//!   generated in code with no asset files, and [`builtin_scene`] builds one by name.
+//!   generated in code with no asset files, and [`builtin_scene`] builds one by name
+//!   ([`builtin_scene_with`]: with the culling override).
 //! - Each call returns a [`LoadedScene`]: the [`Scene`], ready for any
 //!   [`Backend`](kantele_rules::backend::Backend), and a [`SceneInfo`] with facts and warnings about
 //!   the source.
@@ -37,11 +40,14 @@ use std::path::{Path, PathBuf};
 
 use kantele_rules::scene::{Scene, Shading};
 use kantele_rules::shade::pbr::Tonemap;
+use kantele_rules::state::CullMode;
 use thiserror::Error;
 
 mod accessor;
 mod budget;
 mod builtin;
+mod choices;
+mod cull_override;
 mod ear_clip;
 mod environment_file;
 mod gltf_loader;
@@ -68,7 +74,9 @@ mod stl_loader;
 pub mod texture_util;
 mod uri;
 
-pub use gltf_loader::{AnimationChoice, AnimationPlayer, PoseError};
+pub use gltf_loader::{AnimationPlayer, PoseError};
+pub use choices::{AnimationChoice, FileAnimation, FileScene, IndexOrName, SceneChoice};
+pub use cull_override::override_culling;
 pub use mesh_util::flat_normals;
 
 /// Where the last panic that the loaders caught on this thread (one of a dependency's known
@@ -123,9 +131,17 @@ pub struct SceneInfo {
     /// Features the file uses that are ignored (extensions, unplayable animation channels,
     /// ...), once each.
     pub ignored: Vec<String>,
-    /// Names of the file's animations, by index (`animation N` for one without a name); see
-    /// [`LoadOptions::animation`].
-    pub animations: Vec<String>,
+    /// The glTF file's scenes in file order, with the default one and the one drawn marked;
+    /// empty for other formats and built-in scenes (one scene each).
+    pub scenes: Vec<FileScene>,
+    /// The glTF file's animations in file order, with their lengths.
+    pub animations: Vec<FileAnimation>,
+    /// Names of the glTF file's material variants (`KHR_materials_variants`), in file order
+    /// (`variant N` for one without a name).
+    pub variants: Vec<String>,
+    /// Index into [`SceneInfo::variants`] of the variant drawn ([`LoadOptions::variant`]);
+    /// `None`: the default materials.
+    pub variant_loaded: Option<usize>,
 }
 
 impl SceneInfo {
@@ -222,7 +238,11 @@ pub(crate) fn one_line(message: &str) -> String {
 pub const DEFAULT_MAX_MEMORY: u64 = 4 << 30;
 
 /// What a load may do: its memory budget, where it may read, and whether problems that can be
-/// worked around (a missing texture file) are errors.
+/// worked around (a missing texture file) are errors; what to draw of a glTF file (which scene,
+/// which material variant); and how the result is shaded and culled.
+///
+/// A scene or variant choice applies to glTF files only: OBJ, PLY and STL files and built-in
+/// scenes have one scene and no variants, and loading one with either choice is an error.
 #[derive(Clone, Debug)]
 pub struct LoadOptions {
     /// Bytes the load may allocate for what the file controls (vertices, indices, texels,
@@ -262,6 +282,20 @@ pub struct LoadOptions {
     /// before the first key the first holds, after the last key the last. Ignored without an
     /// animation; a NaN or infinite time is an error.
     pub time: f32,
+    /// Which scene of a glTF file to draw; `None` (default): the file's default scene (its
+    /// `scene`, else scene 0). A choice that matches no scene is an error listing the file's
+    /// scenes ([`SceneInfo::scenes`] lists them after a load).
+    pub scene: Option<SceneChoice>,
+    /// The material variant (`KHR_materials_variants`) to draw, by name: a primitive whose
+    /// `mappings` name it is drawn with the mapped material instead of its own. `None`
+    /// (default): every primitive's own material, as the extension says for no choice. A name
+    /// the file does not define is an error listing its variants ([`SceneInfo::variants`]).
+    pub variant: Option<String>,
+    /// Face culling for every material, overriding the file's ([`override_culling`]):
+    /// [`CullMode::None`] draws both faces, [`CullMode::Back`] culls back faces,
+    /// [`CullMode::Front`] culls front faces (it reverses every triangle). `None` (default): the
+    /// file decides (glTF `doubleSided`; OBJ, PLY and STL files are double-sided).
+    pub cull: Option<CullMode>,
 }
 
 /// Which environment lights a PBR scene.
@@ -293,6 +327,9 @@ impl Default for LoadOptions {
             tonemap: Tonemap::PbrNeutral,
             animation: None,
             time: 0.0,
+            scene: None,
+            variant: None,
+            cull: None,
         }
     }
 }
@@ -305,7 +342,8 @@ pub fn load_scene(path: &Path) -> Result<LoadedScene, LoadError> {
     load_scene_with(path, &LoadOptions::default())
 }
 
-/// Loads a scene file under the given options (memory budget, read policy, strictness).
+/// Loads a scene file under the given options (memory budget, read policy, strictness, scene,
+/// variant, culling).
 ///
 /// Malformed input of any kind gives an error naming the file; the loader does not panic and
 /// does not allocate beyond `options.max_memory` for what the file controls.
@@ -326,11 +364,17 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
                 })
             }
         };
+    if !matches!(extension.as_deref(), Some("gltf" | "glb")) {
+        refuse_scene_choices(options).map_err(|e| LoadError::invalid(path, e))?;
+    }
     // The parsing crates are defensive but not panic-free on every malformed input (unchecked
     // `unreachable!`s, arithmetic on counts); a panic there must become a one-line error, not a
     // crash or a backtrace on stderr.
     match quiet_panic::catch(|| loader(path, options)) {
         Ok(Ok(mut loaded)) => {
+            if let Some(cull) = options.cull {
+                override_culling(&mut loaded.scene, cull);
+            }
             loaded.info.finish();
             Ok(loaded)
         }
@@ -362,6 +406,47 @@ fn builtin_names() -> Vec<&'static str> {
 /// Builds a built-in scene by name.
 pub fn builtin_scene(name: &str) -> Result<LoadedScene, LoadError> {
     builtin::build(name).ok_or_else(|| LoadError::UnknownBuiltin(name.to_string()))
+}
+
+/// Builds a built-in scene by name with the options that apply to built-in scenes: the
+/// culling override ([`LoadOptions::cull`]). A scene or variant choice is an error (a built-in
+/// scene has one scene and no variants); the other options are not used.
+pub fn builtin_scene_with(name: &str, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
+    if !builtin_names().contains(&name) {
+        return Err(LoadError::UnknownBuiltin(name.to_string()));
+    }
+    refuse_scene_choices(options).map_err(|e| LoadError::Invalid {
+        path: PathBuf::from(format!("builtin:{name}")),
+        message: e,
+    })?;
+    let mut loaded = builtin_scene(name)?;
+    if let Some(cull) = options.cull {
+        override_culling(&mut loaded.scene, cull);
+    }
+    Ok(loaded)
+}
+
+/// The error for a scene or variant choice on a source that has one scene and no variants.
+fn refuse_scene_choices(options: &LoadOptions) -> Result<(), String> {
+    if let Some(choice) = &options.scene {
+        return Err(format!(
+            "cannot draw scene {}: only glTF files have scenes to choose from (this has one)",
+            one_line(&choice.to_string())
+        ));
+    }
+    if let Some(variant) = &options.variant {
+        return Err(format!(
+            "cannot draw material variant '{}': only glTF files have material variants",
+            one_line(variant)
+        ));
+    }
+    if let Some(choice) = &options.animation {
+        return Err(format!(
+            "cannot pose by animation {}: only glTF files have animations",
+            one_line(&choice.to_string())
+        ));
+    }
+    Ok(())
 }
 
 #[cfg(test)]

@@ -13,14 +13,7 @@ use super::animation::{Interpolation, Keyframes};
 use crate::accessor::{read_f32, BufferData};
 use crate::budget::Budget;
 
-/// Which of the file's animations a load plays (see [`crate::LoadOptions::animation`]).
-#[derive(Clone, Debug, PartialEq, Eq)]
-pub enum AnimationChoice {
-    /// The animation at this index of the file's `animations`.
-    Index(usize),
-    /// The first animation with this name.
-    Name(String),
-}
+pub(crate) use crate::choices::AnimationChoice;
 
 /// What a channel animates.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -3,6 +3,7 @@
 mod animation;
 mod camera;
 mod clip;
+mod catalogue;
 mod material;
 mod material_extensions;
 mod morph;
@@ -13,7 +14,6 @@ mod rig_builder;
 mod skin;
 mod spec_gloss;
 
-pub use clip::AnimationChoice;
 pub use pose::{AnimationPlayer, PoseError};
 
 use std::collections::HashMap;
@@ -44,6 +44,7 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "EXT_texture_webp",
     "EXT_meshopt_compression",
     "KHR_texture_basisu",
+    "KHR_materials_variants",
 ];
 
 /// Extensions that change how geometry or images are stored and that this loader cannot decode:
@@ -82,6 +83,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     let mut value: serde_json::Value = serde_json::from_slice(&json)
         .map_err(|e| invalid(format!("not a valid glTF file: {e}")))?;
     drop(json);
+    // Read before patching, which drops the animations.
+    let animations = catalogue::read_animations(&value, &mut budget).map_err(invalid)?;
     let patched = patch(&mut value).map_err(invalid)?;
     for w in &patched.warnings {
         info.warn(w.clone());
@@ -102,6 +105,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         policy: &policy,
         budget,
         patched,
+        animations,
         scene: Scene::default(),
         info,
         image_textures: HashMap::new(),
@@ -246,6 +250,8 @@ struct Loader<'a> {
     budget: Budget,
     /// What patching the JSON found (the image each texture shows).
     patched: Patched,
+    /// The file's animations, for [`SceneInfo::animations`] (taken when listed).
+    animations: Vec<catalogue::AnimationTimes>,
     scene: Scene,
     info: SceneInfo,
     /// glTF image index → index into `scene.textures` (`None`: it could not be loaded).

@@ -25,16 +25,14 @@ impl Loader<'_> {
                     .collect()
             })
             .unwrap_or_default();
+        self.catalogue()?;
         for material in document.materials() {
             let converted = self.material(&material)?;
             self.scene.materials.push(converted);
         }
         self.prepare_rig()?;
 
-        let Some(gltf_scene) = document
-            .default_scene()
-            .or_else(|| document.scenes().next())
-        else {
+        let Some(gltf_scene) = self.chosen_scene()? else {
             self.info.warn("the file has no scene: nothing is drawn");
             self.scene.camera = framing_camera(&self.scene);
             return Ok(LoadedScene {

@@ -45,7 +45,8 @@ impl Loader<'_> {
         let mesh_name = named(mesh.name(), "mesh", mesh.index());
         let what = format!("mesh '{mesh_name}' primitive {}", primitive.index());
         let mode = primitive.mode();
-        let material = match primitive.material().index() {
+        let own = primitive.material().index();
+        let material = match self.variant_material(primitive, &what)?.or(own) {
             Some(m) => m,
             None => self.default_material(),
         };

@@ -41,11 +41,6 @@ impl Loader<'_> {
     /// there is either.
     pub(super) fn prepare_rig(&mut self) -> Result<(), LoadError> {
         let animations = &self.patched.animations;
-        self.info.animations = animations
-            .iter()
-            .enumerate()
-            .map(|(i, a)| clip::animation_name(a, i))
-            .collect();
         for feature in clip::unplayable_paths(animations) {
             self.info.ignore(feature);
         }

@@ -21,6 +21,7 @@ mod obj_files;
 mod obj_materials;
 mod ply_stl_files;
 mod reference_scenes;
+mod scene_choices;
 mod spec_gloss;
 mod srgb8_target;
 mod valid_files;
