@@ -17,6 +17,7 @@ OUTPUTS: List[str]
 
 Shading = Literal["auto", "lambert", "pbr"]
 Tonemap = Literal["none", "pbr-neutral", "aces"]
+Cull = Literal["back", "front", "none"]
 
 def load(
     path: PathLike,
@@ -26,13 +27,23 @@ def load(
     environment_rotation: float = 0.0,
     exposure: float = 0.0,
     tonemap: Tonemap = "pbr-neutral",
+    *,
+    scene: Union[int, str, None] = None,
+    variant: Optional[str] = None,
+    animation: Union[int, str, None] = None,
+    time: float = 0.0,
+    cull: Optional[Cull] = None,
 ) -> Scene:
     """Loads a glTF 2.0 (`.gltf`, `.glb`), OBJ, PLY or STL file. `FileNotFoundError`/`OSError`
     when it cannot be read, `ValueError` when it is malformed. `shading`: `auto` (glTF reference
     scenes and OBJ, PLY and STL files Lambert, other glTF files PBR), `lambert` or `pbr`; for
     PBR, `environment` (`"studio"`, `"none"` or an .hdr / .exr file; default: the studio when
     the file has no lights), `environment_intensity`, `environment_rotation` (degrees about
-    +Y), `exposure` (stops) and `tonemap`, as the `kantele` command's options."""
+    +Y), `exposure` (stops) and `tonemap`, as the `kantele` command's options. Of a glTF
+    file, `scene` (index or name) picks the scene, `variant` a material variant
+    (KHR_materials_variants), `animation` (index or name) and `time` (seconds) the pose
+    (without `animation`: the rest pose, skins applied); `cull` overrides every material's face
+    culling (default: glTF by `doubleSided`, OBJ, PLY and STL two-sided)."""
 
 def write_png(path: PathLike, image: npt.NDArray[np.uint8]) -> None:
     """Writes a `uint8` (H, W, 4) or (H, W, 3) image, row 0 at the top, as PNG."""
@@ -127,8 +138,22 @@ class Scene:
         environment_rotation: float = 0.0,
         exposure: float = 0.0,
         tonemap: Tonemap = "pbr-neutral",
+        *,
+        scene: Union[int, str, None] = None,
+        variant: Optional[str] = None,
+        animation: Union[int, str, None] = None,
+        time: float = 0.0,
+        cull: Optional[Cull] = None,
     ) -> Scene:
         """Same as `kantele.load`."""
+    def at_time(self, time: float) -> Scene:
+        """This scene posed at `time` seconds of the animation it was loaded with, as loading
+        at that time would give, without reading the file again. `ValueError` for a scene
+        loaded without an animation."""
+    @property
+    def animation(self) -> Optional[Tuple[int, str, Tuple[float, float]]]:
+        """The animation the scene was loaded with: (index, name, (first, last key time)), or
+        None."""
     @staticmethod
     def from_arrays(
         vertices: npt.ArrayLike,

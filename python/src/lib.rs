@@ -23,7 +23,7 @@ use scene::PyScene;
 /// Loads a glTF 2.0 (`.gltf`, `.glb`), OBJ, PLY or STL file into a `Scene` (the arguments as
 /// `Scene.load`'s).
 #[pyfunction]
-#[pyo3(signature = (path, shading = "auto", environment = None, environment_intensity = 1.0, environment_rotation = 0.0, exposure = 0.0, tonemap = "pbr-neutral"))]
+#[pyo3(signature = (path, shading = "auto", environment = None, environment_intensity = 1.0, environment_rotation = 0.0, exposure = 0.0, tonemap = "pbr-neutral", *, scene = None, variant = None, animation = None, time = 0.0, cull = None))]
 #[allow(clippy::too_many_arguments)]
 fn load(
     py: Python<'_>,
@@ -34,6 +34,11 @@ fn load(
     environment_rotation: f32,
     exposure: f32,
     tonemap: &str,
+    scene: Option<scene::NameOrIndex>,
+    variant: Option<String>,
+    animation: Option<scene::NameOrIndex>,
+    time: f32,
+    cull: Option<&str>,
 ) -> PyResult<PyScene> {
     let options = scene::shading_options(
         shading,
@@ -43,6 +48,7 @@ fn load(
         exposure,
         tonemap,
     )?;
+    let options = scene::choice_options(options, scene, variant, animation, time, cull)?;
     PyScene::load_path(py, path, options)
 }
 

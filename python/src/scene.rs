@@ -10,7 +10,8 @@ use kantele::multisample::SampleCount;
 use kantele::rop::TargetFormat;
 use kantele::scene::{Scene, Shading};
 use kantele::shade::pbr::Tonemap;
-use kantele_scene::{EnvironmentChoice, LoadOptions};
+use kantele::state::CullMode;
+use kantele_scene::{AnimationChoice, AnimationPlayer, EnvironmentChoice, LoadOptions, SceneChoice};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -34,6 +35,8 @@ pub struct PyScene {
     source: String,
     warnings: Vec<String>,
     cpu: Mutex<Option<CachedCpu>>,
+    /// The animation the scene was loaded with, to pose it at other times (`at_time`).
+    animation: Option<AnimationPlayer>,
 }
 
 impl PyScene {
@@ -47,6 +50,7 @@ impl PyScene {
             source,
             warnings,
             cpu: Mutex::new(None),
+            animation: None,
         })
     }
 
@@ -55,8 +59,59 @@ impl PyScene {
         let loaded = py
             .detach(|| kantele_scene::load_scene_with(&path, &options))
             .map_err(load_error)?;
-        Self::new(loaded.scene, loaded.info.source, loaded.info.warnings)
+        let mut scene = Self::new(loaded.scene, loaded.info.source, loaded.info.warnings)?;
+        scene.animation = loaded.animation;
+        Ok(scene)
     }
+}
+
+/// A scene or animation named in Python: an `int` index or a `str` name.
+#[derive(FromPyObject)]
+pub enum NameOrIndex {
+    /// By position in the file.
+    Index(usize),
+    /// By name.
+    Name(String),
+}
+
+/// `options` with `load`'s choice arguments: which scene, material variant and animation pose
+/// of the file, and the culling override (see `Scene.load`).
+pub fn choice_options(
+    options: LoadOptions,
+    scene: Option<NameOrIndex>,
+    variant: Option<String>,
+    animation: Option<NameOrIndex>,
+    time: f32,
+    cull: Option<&str>,
+) -> PyResult<LoadOptions> {
+    if !time.is_finite() {
+        return Err(value_error("time must be a finite number of seconds"));
+    }
+    let cull = match cull {
+        None => None,
+        Some("back") => Some(CullMode::Back),
+        Some("front") => Some(CullMode::Front),
+        Some("none") => Some(CullMode::None),
+        Some(other) => {
+            return Err(value_error(format!(
+                "unknown cull '{other}' (choose from: back, front, none)"
+            )))
+        }
+    };
+    Ok(LoadOptions {
+        scene: scene.map(|s| match s {
+            NameOrIndex::Index(i) => SceneChoice::Index(i),
+            NameOrIndex::Name(n) => SceneChoice::Name(n),
+        }),
+        variant,
+        animation: animation.map(|a| match a {
+            NameOrIndex::Index(i) => AnimationChoice::Index(i),
+            NameOrIndex::Name(n) => AnimationChoice::Name(n),
+        }),
+        time,
+        cull,
+        ..options
+    })
 }
 
 /// The load options of `load`'s shading arguments (see `Scene.load`).
@@ -337,8 +392,13 @@ impl PyScene {
     /// when the file has no lights), `environment_intensity`, `environment_rotation` (degrees
     /// about +Y), `exposure` (stops) and `tonemap` (`none`, `pbr-neutral`, `aces`), as the
     /// `kantele` command's options of the same names.
+    ///
+    /// Of a glTF file, `scene` (index or name) picks the scene to draw, `variant` a material
+    /// variant (`KHR_materials_variants`), and `animation` (index or name) with `time`
+    /// (seconds) the pose; `cull` (`back`, `front` or `none`) overrides every material's face
+    /// culling. `at_time` poses a scene loaded with an animation at other times.
     #[staticmethod]
-    #[pyo3(signature = (path, shading = "auto", environment = None, environment_intensity = 1.0, environment_rotation = 0.0, exposure = 0.0, tonemap = "pbr-neutral"))]
+    #[pyo3(signature = (path, shading = "auto", environment = None, environment_intensity = 1.0, environment_rotation = 0.0, exposure = 0.0, tonemap = "pbr-neutral", *, scene = None, variant = None, animation = None, time = 0.0, cull = None))]
     #[allow(clippy::too_many_arguments)]
     fn load(
         py: Python<'_>,
@@ -349,6 +409,11 @@ impl PyScene {
         environment_rotation: f32,
         exposure: f32,
         tonemap: &str,
+        scene: Option<NameOrIndex>,
+        variant: Option<String>,
+        animation: Option<NameOrIndex>,
+        time: f32,
+        cull: Option<&str>,
     ) -> PyResult<Self> {
         let options = shading_options(
             shading,
@@ -358,7 +423,35 @@ impl PyScene {
             exposure,
             tonemap,
         )?;
+        let options = choice_options(options, scene, variant, animation, time, cull)?;
         Self::load_path(py, path, options)
+    }
+
+    /// This scene posed at `time` seconds of the animation it was loaded with (`load`'s
+    /// `animation`): a new `Scene`, as loading at that time would give, without reading the
+    /// file again. Raises `ValueError` for a scene loaded without an animation.
+    fn at_time(&self, py: Python<'_>, time: f32) -> PyResult<Self> {
+        let Some(player) = &self.animation else {
+            return Err(value_error(format!(
+                "{}: loaded without an animation (pass animation= to load)",
+                self.source
+            )));
+        };
+        let mut scene = Scene::clone(&self.scene);
+        py.detach(|| player.pose(&mut scene, time))
+            .map_err(|e| value_error(format!("{}: {e}", self.source)))?;
+        let mut posed = Self::new(scene, self.source.clone(), self.warnings.clone())?;
+        posed.animation = Some(player.clone());
+        Ok(posed)
+    }
+
+    /// The animation this scene was loaded with, as `(index, name, (first, last))` (the key
+    /// times its channels span, seconds), or `None`.
+    #[getter]
+    fn animation(&self) -> Option<(usize, String, (f32, f32))> {
+        self.animation
+            .as_ref()
+            .map(|p| (p.index(), p.name().to_string(), p.time_range()))
     }
 
     /// A scene of one mesh from numpy arrays: `vertices` (N, 3) floats, `faces` (M, 3)

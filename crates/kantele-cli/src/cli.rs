@@ -54,6 +54,9 @@ pub struct ThumbnailArgs {
     /// Width and height in pixels.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub size: u32,
+    /// What to draw of the file.
+    #[command(flatten)]
+    pub choice: ChoiceArgs,
 }
 
 /// Which scenes to work on: files and built-in scenes.
@@ -98,6 +101,46 @@ pub struct SceneArgs {
     /// Tone map of PBR scenes.
     #[arg(long, value_enum, default_value_t = TonemapArg::PbrNeutral)]
     pub tonemap: TonemapArg,
+    /// What to draw of each file: scene, material variant, animation pose, culling.
+    #[command(flatten)]
+    pub choice: ChoiceArgs,
+}
+
+/// What to draw of a file: which glTF scene, material variant and animation pose, and how
+/// faces are culled.
+#[derive(Debug, Args, Clone, Default)]
+pub struct ChoiceArgs {
+    /// The glTF scene to draw, by index or name (default: the file's default scene; `kantele
+    /// info` lists them).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub scene: Option<String>,
+    /// The material variant to draw (KHR_materials_variants), by name (default: the file's own
+    /// materials; `kantele info` lists them).
+    #[arg(long, value_name = "NAME")]
+    pub variant: Option<String>,
+    /// The glTF animation to pose the scene by, by index or name (default: the rest pose, skins
+    /// applied; `kantele info` lists the animations with their lengths).
+    #[arg(long, value_name = "NAME|INDEX")]
+    pub animation: Option<String>,
+    /// The time of --animation to pose at, seconds (default 0; before the first key the
+    /// first holds, after the last key the last).
+    #[arg(long, value_name = "SECONDS", requires = "animation", allow_hyphen_values = true, value_parser = parse_finite)]
+    pub time: Option<f32>,
+    /// Face culling of every material: `back`, `front` or `none` (default: the file's: glTF
+    /// materials by `doubleSided`; OBJ, PLY and STL faces are drawn from both sides).
+    #[arg(long, value_enum)]
+    pub cull: Option<CullArg>,
+}
+
+/// `--cull`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CullArg {
+    /// Cull back faces.
+    Back,
+    /// Cull front faces.
+    Front,
+    /// Draw both faces.
+    None,
 }
 
 /// `--shading`.
@@ -129,6 +172,17 @@ fn parse_finite(s: &str) -> Result<f32, String> {
         .ok()
         .filter(|v| v.is_finite())
         .ok_or_else(|| format!("'{s}' is not a finite number"))
+}
+
+/// Parses `A:B`, two finite times in seconds with A ≤ B.
+fn parse_time_range(s: &str) -> Result<(f32, f32), String> {
+    let bad = || format!("'{s}' is not a time range A:B in seconds with A <= B (e.g. 0:2.5)");
+    let (a, b) = s.split_once(':').ok_or_else(bad)?;
+    let (a, b) = (parse_finite(a).map_err(|_| bad())?, parse_finite(b).map_err(|_| bad())?);
+    if a > b {
+        return Err(bad());
+    }
+    Ok((a, b))
 }
 
 /// Parses a finite number ≥ 0.
@@ -301,9 +355,16 @@ pub struct RenderArgs {
     /// Print one JSON line per finished image on stdout.
     #[arg(long)]
     pub json: bool,
-    /// Frames per second of an animated -o (.gif, .apng).
+    /// Frames per second of an animated -o (.gif, .apng) and time steps per second of
+    /// --time-range.
     #[arg(long, value_name = "N", default_value_t = 24, value_parser = clap::value_parser!(u16).range(1..=100))]
     pub fps: u16,
+    /// A sequence of --animation from A to B seconds: one picture per time step, at A, A +
+    /// 1/fps, A + 2/fps, … up to B (--fps sets the steps); each written to its own files (a
+    /// numbered -o: {frame}) or all in one .gif/.apng. With several views (--orbit, --views)
+    /// every view is drawn at every time, time by time. Each sidecar records its time.
+    #[arg(long, value_name = "A:B", requires = "animation", conflicts_with = "time", value_parser = parse_time_range)]
+    pub time_range: Option<(f32, f32)>,
     /// Skip images whose files all exist already (resume an interrupted batch).
     #[arg(long)]
     pub skip_existing: bool,

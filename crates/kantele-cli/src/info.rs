@@ -92,6 +92,19 @@ pub fn describe(loaded: &LoadedScene) -> Value {
         "clear_color": scene.clear_color.to_array(),
         "bounding_sphere": sphere,
         "extensions_used": info.extensions_used,
+        "scenes": info.scenes.iter().map(|f| json!({
+            "index": f.index,
+            "name": f.name,
+            "default": f.is_default,
+            "drawn": f.loaded,
+        })).collect::<Vec<_>>(),
+        "animations": info.animations.iter().map(|a| json!({
+            "index": a.index,
+            "name": a.name,
+            "duration_seconds": a.duration_seconds,
+        })).collect::<Vec<_>>(),
+        "variants": info.variants,
+        "variant": info.variant_loaded.and_then(|i| info.variants.get(i)),
         "warnings": info.warnings,
         "ignored": info.ignored,
     })
@@ -155,6 +168,46 @@ pub fn table(loaded: &LoadedScene) -> String {
         scene.ambient
     );
     let _ = writeln!(s, "extensions  {}", list(&info.extensions_used));
+    if !info.scenes.is_empty() {
+        let scenes: Vec<String> = info
+            .scenes
+            .iter()
+            .map(|f| {
+                let mut text = format!("{}", f.index);
+                if let Some(name) = &f.name {
+                    let _ = write!(text, " '{name}'");
+                }
+                match (f.is_default, f.loaded) {
+                    (true, true) => text.push_str(" (default, drawn)"),
+                    (true, false) => text.push_str(" (default)"),
+                    (false, true) => text.push_str(" (drawn)"),
+                    (false, false) => {}
+                }
+                text
+            })
+            .collect();
+        let _ = writeln!(s, "scenes      {}", scenes.join(", "));
+    }
+    let animations: Vec<String> = info
+        .animations
+        .iter()
+        .map(|a| {
+            let name = a.name.as_deref().map(|n| format!(" '{n}'")).unwrap_or_default();
+            format!("{}{name} ({:.3} s)", a.index, a.duration_seconds)
+        })
+        .collect();
+    let _ = writeln!(s, "animations  {}", list(&animations));
+    if !info.variants.is_empty() {
+        let drawn = info
+            .variant_loaded
+            .and_then(|i| info.variants.get(i))
+            .map_or("the default materials".to_string(), |v| format!("'{v}'"));
+        let _ = writeln!(
+            s,
+            "variants    {} (drawn: {drawn})",
+            list(&info.variants)
+        );
+    }
     if let Some((c, r)) = scene.bounding_sphere() {
         let _ = writeln!(s, "bounds      centre {c:.3}, radius {r:.3}");
     }

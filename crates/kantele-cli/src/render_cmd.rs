@@ -16,6 +16,7 @@ use kantele::stats::FrameStats;
 use kantele::RenderError;
 use kantele_output::output::OutputSet;
 use kantele_output::pose::sidecar::{AnimationSidecar, InstanceId, PrimitiveId, SidecarCamera};
+use kantele_output::pose::sidecar::SidecarAnimation;
 use kantele_output::pose::sidecar::{SidecarDepth, SidecarIds};
 use kantele_output::pose::sidecar::{SidecarNormals, MATRIX_LAYOUT};
 use kantele_output::pose::{rows, CameraPose, Sidecar};
@@ -31,6 +32,7 @@ use crate::output::{digits_for, expand_template, extension, has_placeholder, Tem
 use crate::output_plan::OutputGuard;
 use crate::scenes::{self, Input, Warnings};
 use crate::signals::InterruptFlag;
+use kantele_scene::AnimationPlayer;
 
 /// The colour output name that means standard output.
 pub const STDOUT: &str = "-";
@@ -233,6 +235,30 @@ fn frame_memory(args: &RenderArgs) -> usize {
     usize::try_from(args.frame_memory.unwrap_or(DEFAULT_FRAME_MEMORY)).unwrap_or(usize::MAX)
 }
 
+/// Most time steps one `--time-range` may make.
+const MAX_TIME_STEPS: u64 = 100_000;
+
+/// The times of `--time-range A:B` at `--fps N`: A + k/N for k = 0, 1, … while it is at most
+/// B (each computed from k, not summed, so a frame's time does not depend on the frames before
+/// it); one step of no time without a range.
+fn time_steps(args: &RenderArgs) -> Result<Vec<Option<f32>>> {
+    let Some((a, b)) = args.time_range else {
+        return Ok(vec![None]);
+    };
+    let fps = f64::from(args.fps);
+    // The tolerance keeps B itself when (B - A) * fps is a whole number up to rounding.
+    let count = ((f64::from(b) - f64::from(a)) * fps + 1e-6).floor() as u64 + 1;
+    if count > MAX_TIME_STEPS {
+        bail!(
+            "--time-range {a}:{b} at --fps {} makes {count} time steps, more than {MAX_TIME_STEPS}",
+            args.fps
+        );
+    }
+    Ok((0..count)
+        .map(|k| Some((f64::from(a) + k as f64 / fps) as f32))
+        .collect())
+}
+
 /// The sidecar's depth entry.
 fn depth_entry(args: &RenderArgs, file: Option<String>) -> SidecarDepth {
     let png = file
@@ -269,6 +295,7 @@ struct SidecarInputs<'a> {
     paths: &'a FramePaths,
     backend: &'a dyn Backend,
     ms: f64,
+    animation: Option<SidecarAnimation>,
 }
 
 fn sidecar(args: &RenderArgs, s: &SidecarInputs<'_>) -> Sidecar {
@@ -343,6 +370,7 @@ fn sidecar(args: &RenderArgs, s: &SidecarInputs<'_>) -> Sidecar {
             instance_ids,
             primitive_ids,
         },
+        animation: s.animation.clone(),
     }
 }
 
@@ -353,6 +381,8 @@ struct SceneJob<'a> {
     label: String,
     source: String,
     scene: Arc<Scene>,
+    /// The pose of the scene as it is now (`None`: the rest pose).
+    animation: Option<SidecarAnimation>,
 }
 
 impl SceneJob<'_> {
@@ -469,6 +499,7 @@ impl SceneJob<'_> {
                     paths,
                     backend: &*backend,
                     ms,
+                    animation: self.animation.clone(),
                 },
             );
             files::write_json(&mut set, p, &meta)?;
@@ -506,13 +537,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     check_flags(args)?;
     let inputs = scenes::inputs(&args.input)?;
     let cameras = CameraPlan::new(&args.camera, args.size)?;
+    let steps = time_steps(args)?;
     let views = cameras.views_per_scene();
+    // Frame `step * views + view` of a scene is its view `view` at time step `step`.
+    let frames = steps.len() * views;
     let mut guard = OutputGuard::new(&inputs);
     if let Some(v) = &args.camera.views {
         guard.protect(v);
     }
-    let plan = plan_outputs(args, &inputs, views, &mut guard)?;
-    let total = inputs.len() * views;
+    let plan = plan_outputs(args, &inputs, frames, &mut guard)?;
+    let total = inputs.len() * frames;
 
     let mut backend = make_backend(args.backend, &args.cpu, false)?;
     // Ctrl-C and SIGTERM cancel the frame in flight, not only the next one.
@@ -531,6 +565,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         progress.set_message(input.stem());
         let mut loaded = input.load()?;
         warnings.report(&loaded, |w| progress.suspend(|| eprintln!("{w}")));
+        // The cameras frame the scene as loaded: at --time, or at the first time of a range.
         let (width, height) = cameras.image_size(&loaded, args.size, &label)?;
         let poses = cameras.poses(&loaded, width, height, &label)?;
         for (kind, p) in outs.iter().flat_map(|o| &o.ids) {
@@ -539,50 +574,64 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         if let Some(c) = args.camera.background {
             loaded.scene.clear_color = glam::Vec4::from_array(c);
         }
-        let job = SceneJob {
+        let player = loaded.animation.take();
+        let pose_of = |time: f32| {
+            player.as_ref().map(|p| SidecarAnimation {
+                index: p.index(),
+                name: p.name().to_string(),
+                time,
+            })
+        };
+        let mut job = SceneJob {
             args,
             input,
             source: loaded.info.source.clone(),
+            animation: pose_of(args.input.choice.time.unwrap_or(0.0)),
             scene: Arc::new(loaded.scene),
             label,
         };
-        backend
-            .load(job.scene.clone())
-            .map_err(|e| anyhow!("{}: {e}", job.label))?;
         if is_animation(&args.output) {
             let Some(path) = &outs[0].color else {
                 bail!("an animation cannot go to standard output");
             };
             if args.skip_existing && path.exists() {
-                progress.inc(poses.len() as u64);
+                progress.inc(frames as u64);
                 continue;
             }
             let mut animation = Animation::new(width, height, args.fps);
-            let mut views = Vec::new();
+            let mut sidecars = Vec::new();
             let frame_paths = FramePaths {
                 color: Some(path.clone()),
                 ..FramePaths::default()
             };
-            for pose in &poses {
-                interrupt.check()?;
-                let view = pose.frame_view(&job.scene, Pass::Color);
-                let (frame, ms) = render_pass(backend.as_mut(), &view, &job.label, &interrupt)?;
-                animation
-                    .push(&frame)
-                    .map_err(|e| anyhow!("{}: {e}", path.display()))?;
-                views.push(sidecar(
-                    args,
-                    &SidecarInputs {
-                        input,
-                        source: &job.source,
-                        scene: &job.scene,
-                        pose,
-                        paths: &frame_paths,
-                        backend: backend.as_ref(),
-                        ms,
-                    },
-                ));
-                progress.inc(1);
+            for time in &steps {
+                job.pose_at(*time, player.as_ref(), &pose_of)?;
+                backend
+                    .load(job.scene.clone())
+                    .map_err(|e| anyhow!("{}: {e}", job.label))?;
+                for pose in &poses {
+                    interrupt.check()?;
+                    let view = pose.frame_view(&job.scene, Pass::Color);
+                    let (frame, ms) =
+                        render_pass(backend.as_mut(), &view, &job.label, &interrupt)?;
+                    animation
+                        .push(&frame)
+                        .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+                    sidecars.push(sidecar(
+                        args,
+                        &SidecarInputs {
+                            input,
+                            source: &job.source,
+                            scene: &job.scene,
+                            pose,
+                            paths: &frame_paths,
+                            backend: backend.as_ref(),
+                            ms,
+                            animation: job.animation.clone(),
+                        },
+                    ));
+                    progress.inc(1);
+                }
             }
             interrupt.check()?;
             let mut set = OutputSet::new();
@@ -592,8 +641,8 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 source: job.source.clone(),
                 output: path.display().to_string(),
                 fps: args.fps,
-                frames: views.len(),
-                views,
+                frames: sidecars.len(),
+                views: sidecars,
             };
             if let Some(p) = &outs[0].sidecar {
                 files::write_json(&mut set, p, &meta)?;
@@ -602,26 +651,60 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             set.commit()?;
             continue;
         }
-        for (pose, paths) in poses.iter().zip(outs) {
-            interrupt.check()?;
-            if args.skip_existing && done(paths) {
-                progress.inc(1);
+        for (time, outs) in steps.iter().zip(outs.chunks(views)) {
+            if args.skip_existing && outs.iter().all(done) {
+                progress.inc(outs.len() as u64);
                 continue;
             }
-            let ms = job.render_view(backend.as_mut(), pose, paths, &interrupt)?;
-            if args.json {
-                let line = json!({
-                    "scene": input.stem(),
-                    "output": paths.color.as_ref().map_or("-".into(), |c| c.display().to_string()),
-                    "width": pose.width,
-                    "height": pose.height,
-                    "ms": ms,
-                });
-                progress.suspend(|| println!("{line}"));
+            job.pose_at(*time, player.as_ref(), &pose_of)?;
+            backend
+                .load(job.scene.clone())
+                .map_err(|e| anyhow!("{}: {e}", job.label))?;
+            for (pose, paths) in poses.iter().zip(outs) {
+                interrupt.check()?;
+                if args.skip_existing && done(paths) {
+                    progress.inc(1);
+                    continue;
+                }
+                let ms = job.render_view(backend.as_mut(), pose, paths, &interrupt)?;
+                if args.json {
+                    let mut line = json!({
+                        "scene": input.stem(),
+                        "output": paths.color.as_ref().map_or("-".into(), |c| c.display().to_string()),
+                        "width": pose.width,
+                        "height": pose.height,
+                        "ms": ms,
+                    });
+                    if let Some(t) = time {
+                        line["time"] = json!(t);
+                    }
+                    progress.suspend(|| println!("{line}"));
+                }
+                progress.inc(1);
             }
-            progress.inc(1);
         }
     }
     progress.finish_and_clear();
     Ok(())
+}
+
+impl SceneJob<'_> {
+    /// Poses the scene at `time` of the loaded animation (`None`: leaves it as loaded).
+    fn pose_at(
+        &mut self,
+        time: Option<f32>,
+        player: Option<&AnimationPlayer>,
+        pose_of: &dyn Fn(f32) -> Option<SidecarAnimation>,
+    ) -> Result<()> {
+        let (Some(time), Some(player)) = (time, player) else {
+            return Ok(());
+        };
+        let mut scene = Scene::clone(&self.scene);
+        player
+            .pose(&mut scene, time)
+            .map_err(|e| anyhow!("{}: {e}", self.label))?;
+        self.scene = Arc::new(scene);
+        self.animation = pose_of(time);
+        Ok(())
+    }
 }

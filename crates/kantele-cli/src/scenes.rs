@@ -6,9 +6,10 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Result};
 use kantele::scene::Shading;
 use kantele::shade::pbr::Tonemap;
+use kantele::state::CullMode;
 use kantele_scene::{EnvironmentChoice, LoadOptions, LoadedScene};
 
-use crate::cli::{SceneArgs, ShadingArg, TonemapArg};
+use crate::cli::{CullArg, SceneArgs, ShadingArg, TonemapArg};
 
 /// One scene to load.
 #[derive(Clone, Debug)]
@@ -69,6 +70,14 @@ impl Input {
             .validate()
             .map_err(|e| anyhow!("{}: {e}", self.label()))?;
         Ok(loaded)
+    }
+}
+
+/// A scene or animation named on the command line: digits are an index, anything else a name.
+fn parse_choice<T: std::str::FromStr<Err = std::convert::Infallible>>(text: &str) -> T {
+    match text.parse() {
+        Ok(choice) => choice,
+        Err(never) => match never {},
     }
 }
 
@@ -145,6 +154,15 @@ pub fn inputs(args: &SceneArgs) -> Result<Vec<Input>> {
             TonemapArg::PbrNeutral => Tonemap::PbrNeutral,
             TonemapArg::Aces => Tonemap::Aces,
         },
+        scene: args.choice.scene.as_deref().map(parse_choice),
+        variant: args.choice.variant.clone(),
+        animation: args.choice.animation.as_deref().map(parse_choice),
+        time: args.choice.time.unwrap_or(0.0),
+        cull: args.choice.cull.map(|c| match c {
+            CullArg::Back => CullMode::Back,
+            CullArg::Front => CullMode::Front,
+            CullArg::None => CullMode::None,
+        }),
         ..LoadOptions::default()
     };
     let file = |p: PathBuf| Input::File(p, options.clone());

@@ -28,6 +28,7 @@ pub fn run(args: &ThumbnailArgs) -> Result<()> {
         environment_rotation: 0.0,
         exposure: 0.0,
         tonemap: crate::cli::TonemapArg::PbrNeutral,
+        choice: args.choice.clone(),
     })?;
     if found.len() != 1 {
         anyhow::bail!(

@@ -14,6 +14,7 @@ use std::process::Output;
 mod common;
 
 mod bands;
+mod choices;
 mod compare;
 mod errors;
 mod info_bench;

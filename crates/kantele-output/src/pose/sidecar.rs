@@ -68,6 +68,22 @@ pub struct Sidecar {
     pub normals: Option<SidecarNormals>,
     /// The id image and what the ids mean.
     pub ids: SidecarIds,
+    /// The animation the scene was posed by and the time it was posed at; absent for the
+    /// rest pose.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub animation: Option<SidecarAnimation>,
+}
+
+/// The animation pose of one rendered view (`--animation`, `--time`, `--time-range`): loading
+/// the scene with this animation at this time gives the pictured pose.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SidecarAnimation {
+    /// The animation's index in the file.
+    pub index: usize,
+    /// Its name (`animation N` for one without a name).
+    pub name: String,
+    /// The time posed at, seconds.
+    pub time: f32,
 }
 
 /// The sidecar of an animation (a turntable, `--orbit N -o spin.gif`): one [`Sidecar`] per
