@@ -7,7 +7,7 @@ use anyhow::{anyhow, bail, Result};
 use kantele::scene::Shading;
 use kantele::shade::pbr::Tonemap;
 use kantele::state::CullMode;
-use kantele_scene::{EnvironmentChoice, LoadOptions, LoadedScene};
+use kantele_scene::{EnvironmentChoice, LoadError, LoadOptions, LoadedScene};
 
 use crate::cli::{CullArg, SceneArgs, ShadingArg, TonemapArg};
 
@@ -16,8 +16,9 @@ use crate::cli::{CullArg, SceneArgs, ShadingArg, TonemapArg};
 pub enum Input {
     /// A scene file, with the options it is loaded under.
     File(PathBuf, LoadOptions),
-    /// A built-in scene by name.
-    Builtin(String),
+    /// A built-in scene by name, with the options it is loaded under (its culling; a scene,
+    /// variant or animation choice is refused).
+    Builtin(String, LoadOptions),
 }
 
 impl Input {
@@ -28,7 +29,7 @@ impl Input {
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_else(|| "scene".into()),
-            Input::Builtin(n) => n.clone(),
+            Input::Builtin(n, _) => n.clone(),
         }
     }
 
@@ -36,7 +37,7 @@ impl Input {
     pub fn label(&self) -> String {
         match self {
             Input::File(p, _) => p.display().to_string(),
-            Input::Builtin(n) => format!("builtin:{n}"),
+            Input::Builtin(n, _) => format!("builtin:{n}"),
         }
     }
 
@@ -61,9 +62,12 @@ impl Input {
             Input::File(p, options) => {
                 kantele_scene::load_scene_with(p, options).map_err(|e| anyhow!("{e}"))?
             }
-            Input::Builtin(n) => {
-                kantele_scene::builtin_scene(n).map_err(|e| anyhow!("{}: {e}", self.label()))?
-            }
+            Input::Builtin(n, options) => kantele_scene::builtin_scene_with(n, options)
+                .map_err(|e| match e {
+                    // Only this error leaves the scene unnamed.
+                    LoadError::UnknownBuiltin(_) => anyhow!("{}: {e}", self.label()),
+                    other => anyhow!("{other}"),
+                })?,
         };
         loaded
             .scene
@@ -195,7 +199,7 @@ pub fn inputs(args: &SceneArgs) -> Result<Vec<Input>> {
                 }
             );
         }
-        out.push(Input::Builtin(n.clone()));
+        out.push(Input::Builtin(n.clone(), options.clone()));
     }
     if out.is_empty() {
         bail!("no scene given: name a scene file or use --builtin NAME");
