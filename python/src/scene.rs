@@ -11,7 +11,9 @@ use kantele::rop::TargetFormat;
 use kantele::scene::{Scene, Shading};
 use kantele::shade::pbr::Tonemap;
 use kantele::state::CullMode;
-use kantele_scene::{AnimationChoice, AnimationPlayer, EnvironmentChoice, LoadOptions, SceneChoice};
+use kantele_scene::{
+    AnimationChoice, AnimationPlayer, EnvironmentChoice, LoadOptions, SceneChoice,
+};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 

@@ -178,7 +178,10 @@ fn parse_finite(s: &str) -> Result<f32, String> {
 fn parse_time_range(s: &str) -> Result<(f32, f32), String> {
     let bad = || format!("'{s}' is not a time range A:B in seconds with A <= B (e.g. 0:2.5)");
     let (a, b) = s.split_once(':').ok_or_else(bad)?;
-    let (a, b) = (parse_finite(a).map_err(|_| bad())?, parse_finite(b).map_err(|_| bad())?);
+    let (a, b) = (
+        parse_finite(a).map_err(|_| bad())?,
+        parse_finite(b).map_err(|_| bad())?,
+    );
     if a > b {
         return Err(bad());
     }

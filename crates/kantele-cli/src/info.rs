@@ -192,7 +192,11 @@ pub fn table(loaded: &LoadedScene) -> String {
         .animations
         .iter()
         .map(|a| {
-            let name = a.name.as_deref().map(|n| format!(" '{n}'")).unwrap_or_default();
+            let name = a
+                .name
+                .as_deref()
+                .map(|n| format!(" '{n}'"))
+                .unwrap_or_default();
             format!("{}{name} ({:.3} s)", a.index, a.duration_seconds)
         })
         .collect();
@@ -202,11 +206,7 @@ pub fn table(loaded: &LoadedScene) -> String {
             .variant_loaded
             .and_then(|i| info.variants.get(i))
             .map_or("the default materials".to_string(), |v| format!("'{v}'"));
-        let _ = writeln!(
-            s,
-            "variants    {} (drawn: {drawn})",
-            list(&info.variants)
-        );
+        let _ = writeln!(s, "variants    {} (drawn: {drawn})", list(&info.variants));
     }
     if let Some((c, r)) = scene.bounding_sphere() {
         let _ = writeln!(s, "bounds      centre {c:.3}, radius {r:.3}");

@@ -15,8 +15,8 @@ use kantele::scene::Scene;
 use kantele::stats::FrameStats;
 use kantele::RenderError;
 use kantele_output::output::OutputSet;
-use kantele_output::pose::sidecar::{AnimationSidecar, InstanceId, PrimitiveId, SidecarCamera};
 use kantele_output::pose::sidecar::SidecarAnimation;
+use kantele_output::pose::sidecar::{AnimationSidecar, InstanceId, PrimitiveId, SidecarCamera};
 use kantele_output::pose::sidecar::{SidecarDepth, SidecarIds};
 use kantele_output::pose::sidecar::{SidecarNormals, MATRIX_LAYOUT};
 use kantele_output::pose::{rows, CameraPose, Sidecar};
@@ -612,8 +612,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 for pose in &poses {
                     interrupt.check()?;
                     let view = pose.frame_view(&job.scene, Pass::Color);
-                    let (frame, ms) =
-                        render_pass(backend.as_mut(), &view, &job.label, &interrupt)?;
+                    let (frame, ms) = render_pass(backend.as_mut(), &view, &job.label, &interrupt)?;
                     animation
                         .push(&frame)
                         .map_err(|e| anyhow!("{}: {e}", path.display()))?;

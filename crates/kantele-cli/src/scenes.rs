@@ -62,12 +62,13 @@ impl Input {
             Input::File(p, options) => {
                 kantele_scene::load_scene_with(p, options).map_err(|e| anyhow!("{e}"))?
             }
-            Input::Builtin(n, options) => kantele_scene::builtin_scene_with(n, options)
-                .map_err(|e| match e {
+            Input::Builtin(n, options) => {
+                kantele_scene::builtin_scene_with(n, options).map_err(|e| match e {
                     // Only this error leaves the scene unnamed.
                     LoadError::UnknownBuiltin(_) => anyhow!("{}: {e}", self.label()),
                     other => anyhow!("{other}"),
-                })?,
+                })?
+            }
         };
         loaded
             .scene

@@ -74,9 +74,9 @@ mod stl_loader;
 pub mod texture_util;
 mod uri;
 
-pub use gltf_loader::{AnimationPlayer, PoseError};
 pub use choices::{AnimationChoice, FileAnimation, FileScene, IndexOrName, SceneChoice};
 pub use cull_override::override_culling;
+pub use gltf_loader::{AnimationPlayer, PoseError};
 pub use mesh_util::flat_normals;
 
 /// Where the last panic that the loaders caught on this thread (one of a dependency's known

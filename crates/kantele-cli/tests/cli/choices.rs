@@ -26,7 +26,10 @@ fn info_lists_animations_and_scenes() {
     let animations = v["animations"].as_array().unwrap();
     assert_eq!(animations.len(), 1, "{v}");
     let duration = animations[0]["duration_seconds"].as_f64().unwrap();
-    assert!(duration > 1.0 && duration < 3.0, "CesiumMan's walk: {duration} s");
+    assert!(
+        duration > 1.0 && duration < 3.0,
+        "CesiumMan's walk: {duration} s"
+    );
     let Some(scenes) = realworld("MultipleScenes/glTF/MultipleScenes.gltf") else {
         return;
     };
@@ -60,7 +63,15 @@ fn an_unknown_scene_or_animation_is_one_line() {
     assert_clean_failure(&o, "no-such", &dir, &[]);
     let o = kantele(&["render", &man, "--scene", "7", "-o", &out]);
     assert_clean_failure(&o, "7", &dir, &[]);
-    let o = kantele(&["render", "--builtin", "cube", "--animation", "0", "-o", &out]);
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "--animation",
+        "0",
+        "-o",
+        &out,
+    ]);
     assert_clean_failure(&o, "animation", &dir, &[]);
 }
 

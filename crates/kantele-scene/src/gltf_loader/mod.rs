@@ -2,8 +2,8 @@
 
 mod animation;
 mod camera;
-mod clip;
 mod catalogue;
+mod clip;
 mod material;
 mod material_extensions;
 mod morph;
