@@ -99,12 +99,12 @@ fn a_time_range_sequence_reproduces_frame_by_frame() {
     ]);
     ok(&o);
     let frames: Vec<Vec<u8>> = (0..3)
-        .map(|k| std::fs::read(dir.path(&format!("walk_{k}.png"))).unwrap())
+        .map(|k| std::fs::read(dir.path(&format!("walk_{k:04}.png"))).unwrap())
         .collect();
     assert_ne!(frames[0], frames[1], "the figure moves");
     for (k, frame) in frames.iter().enumerate() {
         let side: serde_json::Value = serde_json::from_slice(
-            &std::fs::read(dir.path(&format!("walk_{k}.png.json"))).unwrap(),
+            &std::fs::read(dir.path(&format!("walk_{k:04}.png.json"))).unwrap(),
         )
         .unwrap();
         let time = side["animation"]["time"].as_f64().unwrap();
@@ -120,7 +120,7 @@ fn a_time_range_sequence_reproduces_frame_by_frame() {
             "--time",
             &time.to_string(),
             "--views",
-            &dir.s(&format!("walk_{k}.png.json")),
+            &dir.s(&format!("walk_{k:04}.png.json")),
             "-o",
             &again,
         ]);
