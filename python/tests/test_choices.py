@@ -24,7 +24,7 @@ def test_at_time_poses_as_loading_at_that_time():
     start = kantele.load(man, animation=0, time=0.0)
     index, name, (first, last) = start.animation
     assert index == 0 and 0.0 <= first < 0.1 and last > 1.0
-    camera = start.camera()
+    camera = start.camera
     for t in (0.5, 1.25):
         loaded = kantele.load(man, animation=0, time=t)
         posed = start.at_time(t)
