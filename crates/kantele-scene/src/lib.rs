@@ -42,6 +42,8 @@ use thiserror::Error;
 mod accessor;
 mod budget;
 mod builtin;
+mod draco_stream;
+mod draco_views;
 mod ear_clip;
 mod environment_file;
 mod gltf_loader;
@@ -75,6 +77,14 @@ pub use mesh_util::flat_normals;
 #[doc(hidden)]
 pub fn last_caught_panic_file() -> Option<String> {
     quiet_panic::last_caught_file()
+}
+
+/// A `.glb` whose one triangle primitive is the given `KHR_draco_mesh_compression` stream (its
+/// attribute 0 as POSITION), sized from the stream's header: the `draco` fuzz target in
+/// `kantele-testkit` loads it (not a public API).
+#[doc(hidden)]
+pub fn draco_stream_glb(stream: &[u8]) -> Vec<u8> {
+    draco_views::single_stream_glb(stream)
 }
 
 /// A loaded scene with what a user checks before rendering it.
