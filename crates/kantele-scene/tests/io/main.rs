@@ -11,6 +11,7 @@ mod common;
 
 mod bad_input;
 mod corpus;
+mod draco_files;
 mod fuzz_replay;
 mod gltf_files;
 mod hostile_files;
