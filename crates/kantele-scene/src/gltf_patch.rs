@@ -1,7 +1,7 @@
 //! The glTF JSON, read and patched before the `gltf` crate sees it: valid files that its
-//! deserializer or validation would reject are made acceptable, and what this loader cannot
-//! decode is refused with one line naming the extension, whether or not the file lists it as
-//! required.
+//! deserializer or validation would reject are made acceptable, accessors filled from Draco data
+//! get buffer views of their own, and what this loader cannot decode is refused with one line
+//! naming the extension, whether or not the file lists it as required.
 
 use serde_json::Value;
 
@@ -16,6 +16,8 @@ pub(crate) struct Patched {
     pub animations: Vec<Value>,
     /// Warnings to record.
     pub warnings: Vec<String>,
+    /// `KHR_draco_mesh_compression` primitives, their accessors given views of their own.
+    pub draco: Vec<crate::draco_views::DracoPrimitive>,
 }
 
 /// Splits a `.glb` into its JSON and binary chunk; other bytes are taken as JSON text.
@@ -47,21 +49,7 @@ pub(crate) fn patch(root: &mut Value) -> Result<Patched, String> {
                 .or_insert_with(|| Value::Array(Vec::new()));
         }
     }
-    if let Some(Value::Array(meshes)) = object.get("meshes") {
-        for (m, mesh) in meshes.iter().enumerate() {
-            let primitives = mesh.get("primitives").and_then(Value::as_array);
-            for (p, primitive) in primitives.into_iter().flatten().enumerate() {
-                if primitive
-                    .pointer("/extensions/KHR_draco_mesh_compression")
-                    .is_some()
-                {
-                    return Err(format!(
-                        "mesh {m} primitive {p} uses KHR_draco_mesh_compression (Draco-compressed geometry), which this loader cannot decode"
-                    ));
-                }
-            }
-        }
-    }
+    patched.draco = crate::draco_views::patch_json(object)?;
     let image_count = object
         .get("images")
         .and_then(Value::as_array)

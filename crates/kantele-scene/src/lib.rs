@@ -48,6 +48,8 @@ mod budget;
 mod builtin;
 mod choices;
 mod cull_override;
+mod draco_stream;
+mod draco_views;
 mod ear_clip;
 mod environment_file;
 mod gltf_loader;
@@ -93,6 +95,14 @@ pub fn last_caught_panic_file() -> Option<String> {
 #[doc(hidden)]
 pub fn fuzz_ktx2(data: &[u8]) {
     ktx2_image::fuzz(data);
+}
+
+/// A `.glb` whose one triangle primitive is the given `KHR_draco_mesh_compression` stream (its
+/// attribute 0 as POSITION), sized from the stream's header: the `draco` fuzz target in
+/// `kantele-testkit` loads it (not a public API).
+#[doc(hidden)]
+pub fn draco_stream_glb(stream: &[u8]) -> Vec<u8> {
+    draco_views::single_stream_glb(stream)
 }
 
 /// A loaded scene with what a user checks before rendering it.

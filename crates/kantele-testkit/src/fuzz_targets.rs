@@ -1,4 +1,4 @@
-//! Bodies of the `gltf`, `obj`, `ply` and `stl` fuzz targets (`fuzz/` at the repository root),
+//! Bodies of the `gltf`, `obj`, `ply`, `stl` and `draco` fuzz targets (`fuzz/` at the repository root),
 //! as plain functions so that a stable test can replay the corpus without a nightly toolchain.
 //!
 //! Each loads the fuzzer's bytes as a scene file in a private, otherwise empty folder (the read
@@ -91,6 +91,13 @@ pub fn ply(data: &[u8]) {
 /// The `stl` target: the bytes as `scene.stl`.
 pub fn stl(data: &[u8]) {
     load_and_render_as(data, "scene.stl");
+}
+
+/// The `draco` target: the bytes as a `KHR_draco_mesh_compression` stream, the one primitive
+/// of a `.glb` whose accessors declare the counts of the stream's header
+/// (`kantele_scene::draco_stream_glb`).
+pub fn draco(data: &[u8]) {
+    load_and_render_as(&kantele_scene::draco_stream_glb(data), "scene.glb");
 }
 
 /// Writes the bytes as the file `name` in a fresh folder, loads it and renders what loads.

@@ -45,15 +45,12 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "EXT_meshopt_compression",
     "KHR_texture_basisu",
     "KHR_materials_variants",
+    "KHR_draco_mesh_compression",
 ];
 
 /// Extensions that change how geometry or images are stored and that this loader cannot decode:
 /// requiring one is an error (using one without requiring it is refused where it is used).
-const UNREADABLE_EXTENSIONS: &[&str] = &[
-    "KHR_draco_mesh_compression",
-    "EXT_texture_avif",
-    "MSFT_texture_dds",
-];
+const UNREADABLE_EXTENSIONS: &[&str] = &["EXT_texture_avif", "MSFT_texture_dds"];
 
 /// Default image size when the scene's extras give none.
 const DEFAULT_RESOLUTION: (u32, u32) = (800, 600);
@@ -94,8 +91,11 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
     let document = check_extensions(path, root, &mut info)?;
     let policy = ReadPolicy::new(path, &options.allow_read);
     let buffers = load_buffers(path, &document, blob, &policy, &mut budget)?;
-    let decoded_views = crate::meshopt_views::decode_views(&document, &buffers, &mut budget)
+    let mut decoded_views = crate::meshopt_views::decode_views(&document, &buffers, &mut budget)
         .map_err(|e| LoadError::invalid(path, e))?;
+    let draco = crate::draco_views::decode_views(&document, &buffers, &patched.draco, &mut budget)
+        .map_err(|e| LoadError::invalid(path, e))?;
+    decoded_views.extend(draco);
     Loader {
         path,
         document: &document,
@@ -243,7 +243,8 @@ struct Loader<'a> {
     path: &'a Path,
     document: &'a gltf::Document,
     buffers: &'a [Vec<u8>],
-    /// `EXT_meshopt_compression` buffer views, decoded.
+    /// `EXT_meshopt_compression` buffer views and those made for `KHR_draco_mesh_compression`
+    /// accessors, decoded.
     decoded_views: &'a HashMap<usize, Vec<u8>>,
     options: &'a LoadOptions,
     policy: &'a ReadPolicy,

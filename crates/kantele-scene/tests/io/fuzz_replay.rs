@@ -188,6 +188,15 @@ fn ktx2_corpus_and_mutations() {
 }
 
 #[test]
+fn draco_corpus_and_mutations() {
+    replay(
+        "draco",
+        0x2f6b_9c1e_83d4_a507,
+        kantele_testkit::fuzz_targets::draco,
+    );
+}
+
+#[test]
 fn raster_corpus_and_mutations() {
     replay(
         "raster",

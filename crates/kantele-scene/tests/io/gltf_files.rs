@@ -378,15 +378,15 @@ fn unsupported_extensions_warn_and_unreadable_required_ones_fail() {
     assert_eq!(w.iter().filter(|w| w.contains("EXT_fancy")).count(), 2);
     assert_eq!(loaded.info.extensions_used.len(), 3);
 
-    g.json["extensionsUsed"] = json!(["KHR_draco_mesh_compression"]);
-    g.json["extensionsRequired"] = json!(["KHR_draco_mesh_compression"]);
-    let path = dir.join("draco.glb");
+    g.json["extensionsUsed"] = json!(["MSFT_texture_dds"]);
+    g.json["extensionsRequired"] = json!(["MSFT_texture_dds"]);
+    let path = dir.join("dds.glb");
     g.write_glb(&path);
     let err = load_scene(&path)
-        .expect_err("draco cannot be read")
+        .expect_err("DDS cannot be read")
         .to_string();
     assert!(
-        err.contains("draco.glb") && err.contains("KHR_draco_mesh_compression"),
+        err.contains("dds.glb") && err.contains("MSFT_texture_dds"),
         "{err}"
     );
 }

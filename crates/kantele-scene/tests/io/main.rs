@@ -12,6 +12,7 @@ mod common;
 mod animation;
 mod bad_input;
 mod corpus;
+mod draco_files;
 mod fuzz_replay;
 mod gltf_files;
 mod hostile_files;

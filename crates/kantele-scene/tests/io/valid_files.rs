@@ -76,14 +76,17 @@ fn texture_without_source_and_ignored_animations() {
 }
 
 #[test]
-fn draco_is_refused_by_name_even_when_not_required() {
+fn draco_data_that_is_not_draco_is_refused_in_one_line() {
     let mut g = textured_quad();
     g.json["meshes"][0]["primitives"][0]["extensions"] =
         json!({"KHR_draco_mesh_compression": {"bufferView": 0, "attributes": {"POSITION": 0}}});
     let err = load_scene(&write(&g, "draco"))
         .expect_err("refused")
         .to_string();
-    assert!(err.contains("KHR_draco_mesh_compression"), "{err}");
+    assert!(
+        err.contains("KHR_draco_mesh_compression") && err.contains("not a Draco stream"),
+        "{err}"
+    );
     assert_eq!(err.lines().count(), 1);
 }
 
