@@ -214,6 +214,12 @@ fn read_connectivity_counts(c: &mut Cursor, method: EncoderMethod) -> Result<Cou
             c.u8()?; // attribute data
             let symbols = c.varint()?;
             let split_symbols = c.varint()?;
+            // The decoder sizes its list of topology splits from this count: each split takes
+            // at least two bytes of the stream.
+            let splits = c.varint()?;
+            if splits > (c.bytes.len() - c.at) as u64 / 2 {
+                return Err("the Draco topology splits exceed the stream".to_string());
+            }
             Ok(Counts {
                 faces,
                 vertices: encoded_vertices.saturating_add(split_symbols),
