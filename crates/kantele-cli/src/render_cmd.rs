@@ -535,7 +535,12 @@ fn progress_bar(total: usize) -> ProgressBar {
 pub fn run(args: &RenderArgs) -> Result<()> {
     let interrupt = InterruptFlag::install()?;
     check_flags(args)?;
-    let inputs = scenes::inputs(&args.input)?;
+    let mut scene_args = args.input.clone();
+    if let Some((start, _)) = args.time_range {
+        // Loaded at the range's first time: the cameras frame that pose.
+        scene_args.choice.time = Some(start);
+    }
+    let inputs = scenes::inputs(&scene_args)?;
     let cameras = CameraPlan::new(&args.camera, args.size)?;
     let steps = time_steps(args)?;
     let views = cameras.views_per_scene();
@@ -575,18 +580,12 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             loaded.scene.clear_color = glam::Vec4::from_array(c);
         }
         let player = loaded.animation.take();
-        let pose_of = |time: f32| {
-            player.as_ref().map(|p| SidecarAnimation {
-                index: p.index(),
-                name: p.name().to_string(),
-                time,
-            })
-        };
+        let time = scene_args.choice.time.unwrap_or(0.0);
         let mut job = SceneJob {
             args,
             input,
             source: loaded.info.source.clone(),
-            animation: pose_of(args.input.choice.time.unwrap_or(0.0)),
+            animation: player.as_ref().map(|p| sidecar_animation(p, time)),
             scene: Arc::new(loaded.scene),
             label,
         };
@@ -605,7 +604,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 ..FramePaths::default()
             };
             for time in &steps {
-                job.pose_at(*time, player.as_ref(), &pose_of)?;
+                job.pose_at(*time, player.as_ref())?;
                 backend
                     .load(job.scene.clone())
                     .map_err(|e| anyhow!("{}: {e}", job.label))?;
@@ -655,7 +654,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 progress.inc(outs.len() as u64);
                 continue;
             }
-            job.pose_at(*time, player.as_ref(), &pose_of)?;
+            job.pose_at(*time, player.as_ref())?;
             backend
                 .load(job.scene.clone())
                 .map_err(|e| anyhow!("{}: {e}", job.label))?;
@@ -688,22 +687,30 @@ pub fn run(args: &RenderArgs) -> Result<()> {
 }
 
 impl SceneJob<'_> {
-    /// Poses the scene at `time` of the loaded animation (`None`: leaves it as loaded).
-    fn pose_at(
-        &mut self,
-        time: Option<f32>,
-        player: Option<&AnimationPlayer>,
-        pose_of: &dyn Fn(f32) -> Option<SidecarAnimation>,
-    ) -> Result<()> {
+    /// Poses the scene at `time` of the loaded animation; `None`, or the time it is posed at
+    /// already, leaves it as it is.
+    fn pose_at(&mut self, time: Option<f32>, player: Option<&AnimationPlayer>) -> Result<()> {
         let (Some(time), Some(player)) = (time, player) else {
             return Ok(());
         };
+        if self.animation.as_ref().is_some_and(|a| a.time == time) {
+            return Ok(());
+        }
         let mut scene = Scene::clone(&self.scene);
         player
             .pose(&mut scene, time)
             .map_err(|e| anyhow!("{}: {e}", self.label))?;
         self.scene = Arc::new(scene);
-        self.animation = pose_of(time);
+        self.animation = Some(sidecar_animation(player, time));
         Ok(())
+    }
+}
+
+/// What a sidecar records of a pose at `time` of `player`'s animation.
+fn sidecar_animation(player: &AnimationPlayer, time: f32) -> SidecarAnimation {
+    SidecarAnimation {
+        index: player.index(),
+        name: player.name().to_string(),
+        time,
     }
 }
