@@ -7,7 +7,6 @@ use std::path::Path;
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use kantele_rules::scene::{Draw, Light, Mesh, Scene, Topology};
 
-use crate::budget::Budget;
 use crate::ear_clip::triangulate_faces;
 use crate::mesh_util::{first_index_out_of_range, flat_normals, framing_camera};
 use crate::mtl_libraries::{MtlLibraries, MAX_LINE_WARNINGS};
@@ -15,7 +14,7 @@ use crate::obj_material::{default_material, Converter};
 use crate::obj_text::{patch_obj, text, UNNAMED_MATERIAL};
 use crate::obj_textures::ObjTextures;
 use crate::obj_wide::{read_lines_points, ObjWide};
-use crate::read_policy::{read_regular_file, ReadPolicy};
+use crate::read_policy::{read_scene_file, ReadPolicy};
 use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
 
 /// Bytes of memory charged per byte of OBJ text before parsing: the parser's vertices (with
@@ -24,12 +23,7 @@ const OBJ_BYTES_PER_TEXT_BYTE: u64 = 32;
 
 /// Loads an `.obj` file and the materials of its `.mtl` libraries.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
-    std::fs::metadata(path).map_err(|source| LoadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let mut budget = Budget::new(options.max_memory);
-    let bytes = read_regular_file(path, &mut budget).map_err(|e| LoadError::invalid(path, e))?;
+    let (bytes, mut budget) = read_scene_file(path, options.max_memory)?;
     budget
         .charge(
             bytes.len() as u64,

@@ -9,6 +9,7 @@ use std::io::Read;
 use std::path::{Path, PathBuf};
 
 use crate::budget::Budget;
+use crate::LoadError;
 
 /// The folders a load may read from (canonical paths).
 #[derive(Debug)]
@@ -66,6 +67,22 @@ pub(crate) fn read_regular_file(file: &Path, budget: &mut Budget) -> Result<Vec<
         .read_to_end(&mut bytes)
         .map_err(|e| e.to_string())?;
     Ok(bytes)
+}
+
+/// The bytes of the scene file a load starts from, with the load's budget (`max_memory`) already
+/// charged for them: a missing file is [`LoadError::Io`], anything else that stops the read a
+/// one-line error naming the file.
+pub(crate) fn read_scene_file(
+    path: &Path,
+    max_memory: u64,
+) -> Result<(Vec<u8>, Budget), LoadError> {
+    std::fs::metadata(path).map_err(|source| LoadError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let mut budget = Budget::new(max_memory);
+    let bytes = read_regular_file(path, &mut budget).map_err(|e| LoadError::invalid(path, e))?;
+    Ok((bytes, budget))
 }
 
 #[cfg(test)]

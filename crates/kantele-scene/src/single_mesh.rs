@@ -10,7 +10,7 @@ use kantele_rules::scene::{Draw, Light, Material, Mesh, Scene, Shading};
 
 use crate::budget::Budget;
 use crate::mesh_util::framing_camera;
-use crate::read_policy::read_regular_file;
+use crate::read_policy::read_scene_file;
 use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
 
 /// Linear base colour of the material of a mesh without vertex colours: a light grey (sRGB
@@ -56,12 +56,7 @@ pub(crate) fn load_single_mesh(
     options: &LoadOptions,
     read_mesh: impl FnOnce(Vec<u8>, String, &mut Budget, &mut SceneInfo) -> Result<Mesh, String>,
 ) -> Result<LoadedScene, LoadError> {
-    std::fs::metadata(path).map_err(|source| LoadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
-    let mut budget = Budget::new(options.max_memory);
-    let bytes = read_regular_file(path, &mut budget).map_err(|e| LoadError::invalid(path, e))?;
+    let (bytes, mut budget) = read_scene_file(path, options.max_memory)?;
     let mut info = SceneInfo {
         source: path.display().to_string(),
         node_count: 1,

@@ -24,7 +24,7 @@ use kantele_rules::shade::texture::ColorSpace;
 
 use crate::budget::Budget;
 use crate::gltf_patch::{patch, split_glb, Patched};
-use crate::read_policy::{read_regular_file, ReadPolicy};
+use crate::read_policy::{read_scene_file, ReadPolicy};
 use crate::uri::read_uri;
 use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
 use material::UvMap;
@@ -57,13 +57,8 @@ const DEFAULT_RESOLUTION: (u32, u32) = (800, 600);
 
 /// Loads a `.gltf` or `.glb` file under `options`.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError> {
-    std::fs::metadata(path).map_err(|source| LoadError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
     let invalid = |m: String| LoadError::invalid(path, m);
-    let mut budget = Budget::new(options.max_memory);
-    let bytes = read_regular_file(path, &mut budget).map_err(invalid)?;
+    let (bytes, mut budget) = read_scene_file(path, options.max_memory)?;
     if bytes.is_empty() {
         return Err(LoadError::invalid(path, "the file is empty"));
     }
