@@ -11,9 +11,7 @@ use kantele::rop::TargetFormat;
 use kantele::scene::{Scene, Shading};
 use kantele::shade::pbr::Tonemap;
 use kantele::state::CullMode;
-use kantele_scene::{
-    AnimationChoice, AnimationPlayer, EnvironmentChoice, LoadOptions, SceneChoice,
-};
+use kantele_scene::{AnimationPlayer, EnvironmentChoice, IndexOrName, LoadOptions};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
@@ -76,6 +74,15 @@ pub enum NameOrIndex {
     Name(String),
 }
 
+impl From<NameOrIndex> for IndexOrName {
+    fn from(choice: NameOrIndex) -> Self {
+        match choice {
+            NameOrIndex::Index(i) => IndexOrName::Index(i),
+            NameOrIndex::Name(n) => IndexOrName::Name(n),
+        }
+    }
+}
+
 /// `options` with `load`'s choice arguments: which scene, material variant and animation pose
 /// of the file, and the culling override (see `Scene.load`).
 pub fn choice_options(
@@ -101,15 +108,9 @@ pub fn choice_options(
         }
     };
     Ok(LoadOptions {
-        scene: scene.map(|s| match s {
-            NameOrIndex::Index(i) => SceneChoice::Index(i),
-            NameOrIndex::Name(n) => SceneChoice::Name(n),
-        }),
+        scene: scene.map(IndexOrName::from),
         variant,
-        animation: animation.map(|a| match a {
-            NameOrIndex::Index(i) => AnimationChoice::Index(i),
-            NameOrIndex::Name(n) => AnimationChoice::Name(n),
-        }),
+        animation: animation.map(IndexOrName::from),
         time,
         cull,
         ..options
