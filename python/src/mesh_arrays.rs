@@ -226,6 +226,7 @@ pub fn scene_from_arrays(arrays: &MeshArrays<'_>, double_sided: bool) -> PyResul
         material.base_color_texture = Some(TextureBinding {
             texture: 0,
             sampler: Sampler::default(),
+            texcoord: 0,
         });
     }
     scene.materials.push(material);

@@ -4,20 +4,24 @@
 //!
 //! Per fragment: the base colour, alpha and emission as the Lambert material reads them; metallic
 //! and roughness (× the blue and green channels of their texture), occlusion, and the shading
-//! normal — the interpolated world normal, bent by the normal texture in the tangent frame
-//! derived from the screen-space derivatives of the world position and the texture coordinate
-//! (as the glTF sample viewer does for meshes without tangents); then
+//! normal — the interpolated world normal, bent by the normal texture in the tangent frame of
+//! the mesh's tangents, or, for a mesh without tangents, in the frame derived from the
+//! screen-space derivatives of the world position and the texture coordinate (as the glTF
+//! sample viewer does for meshes without tangents); then
 //! the dielectric reflectance and specular weight of `KHR_materials_ior` and
 //! `KHR_materials_specular`, the coat of `KHR_materials_clearcoat` (its factor, roughness and
 //! normal texture, bent in the same frame); then [`pbr::shade`] with the emission, exposure
 //! and the tone map.
+//!
+//! Each texture reads one of the mesh's two texture coordinate sets
+//! ([`TextureBinding::texcoord`](kantele_rules::scene::TextureBinding::texcoord)).
 //!
 //! One generic routine shades eight fragments at once ([`FragmentLanes`]) and one fragment
 //! ([`Fragment`], every lane holding it), so both follow the same operations.
 
 use glam::{Mat3, Mat4, Vec2, Vec4};
 
-use crate::material::{material_render_state, StandardVertex};
+use crate::material::material_render_state;
 use crate::pipeline::{
     Fragment, FragmentLanes, LaneProgram, LaneProgramJob, RenderState, ShadedLanes, Shader,
 };
@@ -27,21 +31,67 @@ use kantele_rules::camera::normal_matrix;
 use kantele_rules::scene::{AlphaMode, Material};
 use kantele_rules::shade::pbr::{self, normalize3, ClearcoatLayer, PbrLighting, Surface};
 use kantele_rules::shade::texture::{Sampler, Texture};
+use kantele_rules::vertex::PbrVertex;
 
-/// Where the PBR shader's varyings sit.
+/// Where the PBR shader's first varyings sit; the others follow as the draw needs them
+/// ([`VaryingLayout`]).
 mod at {
     /// World normal, three.
     pub const NORMAL: usize = 0;
     /// World position, three.
     pub const POSITION: usize = 3;
-    /// Texture coordinate, two.
-    pub const TEXCOORD: usize = 6;
-    /// Vertex colour, four.
-    pub const COLOR: usize = 8;
+    /// The first varying after those every draw has.
+    pub const OPTIONAL: usize = 6;
 }
 
-/// A texture with the sampler it is read through.
-pub type BoundTexture<'a> = Option<(&'a Texture, Sampler)>;
+/// Where a draw's optional varyings sit: only what it reads is interpolated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct VaryingLayout {
+    /// The two texture coordinate sets (two each), where a texture reads them.
+    texcoords: [Option<usize>; 2],
+    /// The world tangent and bitangent sign (four), where the mesh has tangents and a normal
+    /// texture is read.
+    tangent: Option<usize>,
+    /// The vertex colour (four), where the mesh has colours.
+    color: Option<usize>,
+    /// Varyings in all.
+    count: usize,
+}
+
+impl VaryingLayout {
+    fn new(texcoords: [bool; 2], tangent: bool, color: bool) -> Self {
+        let mut count = at::OPTIONAL;
+        let mut take = |wanted: bool, size: usize| {
+            wanted.then(|| {
+                count += size;
+                count - size
+            })
+        };
+        let texcoords = [take(texcoords[0], 2), take(texcoords[1], 2)];
+        let tangent = take(tangent, 4);
+        let color = take(color, 4);
+        Self {
+            texcoords,
+            tangent,
+            color,
+            count,
+        }
+    }
+}
+
+/// A texture with the sampler it is read through and the texture coordinate set it reads.
+#[derive(Clone, Copy, Debug)]
+pub struct Bound<'a> {
+    /// The texture.
+    pub texture: &'a Texture,
+    /// How it is sampled.
+    pub sampler: Sampler,
+    /// The mesh's texture coordinate set it reads (0 or 1).
+    pub texcoord: u32,
+}
+
+/// A material texture, where the material has it.
+pub type BoundTexture<'a> = Option<Bound<'a>>;
 
 /// The textures a PBR material reads.
 #[derive(Clone, Copy, Default)]
@@ -69,10 +119,6 @@ pub struct PbrTextures<'a> {
 }
 
 impl<'a> PbrTextures<'a> {
-    fn any(&self) -> bool {
-        self.slots().iter().any(|(_, bound)| bound.is_some())
-    }
-
     /// Every texture with its slot of [`Texels`].
     fn slots(&self) -> [(usize, BoundTexture<'a>); SLOTS] {
         [
@@ -107,8 +153,8 @@ impl<'a> PbrTextures<'a> {
                 }
                 _ => pass == Pass::Color,
             };
-            if let (Some((texture, sampler)), true) = (bound, wanted) {
-                reads.reads[reads.count] = Some((slot, texture, sampler));
+            if let (Some(bound), true) = (bound, wanted) {
+                reads.reads[reads.count] = Some((slot, bound));
                 reads.count += 1;
             }
         }
@@ -135,8 +181,18 @@ type Texels<L> = [[<L as Lanes>::F32; 4]; SLOTS];
 /// The textures one draw reads, in slot order: the first `count` entries.
 #[derive(Clone, Copy)]
 struct TextureReads<'a> {
-    reads: [Option<(usize, &'a Texture, Sampler)>; SLOTS],
+    reads: [Option<(usize, Bound<'a>)>; SLOTS],
     count: usize,
+}
+
+impl TextureReads<'_> {
+    /// Whether any texture read reads texture coordinate set `set`.
+    fn reads_set(&self, set: u32) -> bool {
+        self.reads[..self.count]
+            .iter()
+            .flatten()
+            .any(|(_, bound)| bound.texcoord == set)
+    }
 }
 
 /// The shader of one draw of a PBR scene.
@@ -152,8 +208,11 @@ pub struct PbrShader<'a> {
     pass: Pass,
     /// `(instance id, draw id)` for the id pass.
     ids: (f32, f32),
-    /// The mesh has vertex colours.
-    vertex_colors: bool,
+    /// `model`'s upper 3 × 3 turns the other way (negative determinant): the tangents' `w`
+    /// is negated, so the bitangent keeps pointing along increasing v.
+    mirrored: bool,
+    /// Where the varyings sit.
+    layout: VaryingLayout,
 }
 
 impl<'a> PbrShader<'a> {
@@ -169,24 +228,52 @@ impl<'a> PbrShader<'a> {
         ids: (u32, u32),
     ) -> Self {
         let alpha_tested = !matches!(material.alpha_mode, AlphaMode::Opaque);
-        Self {
+        let reads = textures.reads(pass, alpha_tested, material.has_clearcoat());
+        let mut shader = Self {
             model,
             model_view_projection: view_projection * model,
             normal_matrix: normal_matrix(&model),
             lighting,
             material,
             textures,
-            reads: textures.reads(pass, alpha_tested, material.has_clearcoat()),
+            reads,
             pass,
             ids: (ids.0 as f32, ids.1 as f32),
-            vertex_colors: true,
-        }
+            mirrored: Mat3::from_mat4(model).determinant() < 0.0,
+            layout: VaryingLayout::new([false; 2], false, false),
+        };
+        shader.layout = shader.layout_for(true, false);
+        shader
     }
 
-    /// Whether the mesh has vertex colours (glTF `COLOR_0`; the default is yes).
-    pub fn with_vertex_colors(mut self, present: bool) -> Self {
-        self.vertex_colors = present;
+    /// What the mesh drawn has: vertex colours (glTF `COLOR_0`; the default is yes) and
+    /// tangents (the default is no: the derivative tangent frame).
+    pub fn with_mesh_attributes(mut self, vertex_colors: bool, tangents: bool) -> Self {
+        self.layout = self.layout_for(vertex_colors, tangents);
         self
+    }
+
+    /// The varyings the draw needs with a mesh that has colours and tangents as given: the
+    /// texture coordinate sets its textures read (the derivative frame reads the normal
+    /// texture's), the tangents where a normal texture is bent, the colours.
+    fn layout_for(&self, vertex_colors: bool, tangents: bool) -> VaryingLayout {
+        let bends = self.frame_texture().is_some();
+        let frame_set = self.frame_texture().map(|b| b.texcoord);
+        let set = |s: u32| self.reads.reads_set(s) || (bends && !tangents && frame_set == Some(s));
+        VaryingLayout::new([set(0), set(1)], bends && tangents, vertex_colors)
+    }
+
+    /// The texture whose coordinates orient the tangent frame, when the draw bends a normal:
+    /// the normal texture, else the coat's.
+    fn frame_texture(&self) -> Option<Bound<'_>> {
+        let coat = self.material.has_clearcoat() && self.pass == Pass::Color;
+        match self.pass {
+            Pass::Ids => None,
+            _ => self
+                .textures
+                .normal
+                .or(self.textures.clearcoat_normal.filter(|_| coat)),
+        }
     }
 
     /// The state the material asks for ([`material_render_state`]).
@@ -195,13 +282,12 @@ impl<'a> PbrShader<'a> {
     }
 
     fn varying_count(&self) -> usize {
-        if self.vertex_colors {
-            at::COLOR + 4
-        } else if self.textures.any() {
-            at::TEXCOORD + 2
-        } else {
-            at::POSITION + 3
-        }
+        self.layout.count
+    }
+
+    /// The varying of texture coordinate set `set` (0 where the draw has none: never read).
+    fn texcoord_varying(&self, set: u32) -> usize {
+        self.layout.texcoords[(set as usize).min(1)].unwrap_or(0)
     }
 }
 
@@ -211,7 +297,8 @@ trait Fragments<L: Lanes> {
     fn lanes(&self) -> L;
     fn varying(&self, index: usize) -> L::F32;
     fn derivatives(&self, index: usize) -> (L::F32, L::F32);
-    fn sample(&self, texture: &Texture, sampler: &Sampler) -> [L::F32; 4];
+    /// `texture` sampled at the texture coordinate in varyings `u` and `u + 1`.
+    fn sample(&self, texture: &Texture, sampler: &Sampler, u: usize) -> [L::F32; 4];
     fn front_facing(&self) -> bool;
     fn primitive_id(&self) -> u32;
 }
@@ -230,8 +317,7 @@ impl<L: Lanes> Fragments<L> for FragmentLanes<'_, L> {
         FragmentLanes::derivatives(self, index)
     }
     #[inline(always)]
-    fn sample(&self, texture: &Texture, sampler: &Sampler) -> [L::F32; 4] {
-        let u = at::TEXCOORD;
+    fn sample(&self, texture: &Texture, sampler: &Sampler, u: usize) -> [L::F32; 4] {
         let (du_dx, du_dy) = FragmentLanes::derivatives(self, u);
         let (dv_dx, dv_dy) = FragmentLanes::derivatives(self, u + 1);
         texture.sample_grad_lanes::<L>(
@@ -266,8 +352,12 @@ impl Fragments<Scalar> for Fragment<'_> {
         let (dx, dy) = Fragment::derivatives(self, index);
         (Scalar.splat_f32(dx), Scalar.splat_f32(dy))
     }
-    fn sample(&self, texture: &Texture, sampler: &Sampler) -> [<Scalar as Lanes>::F32; 4] {
-        let u = at::TEXCOORD;
+    fn sample(
+        &self,
+        texture: &Texture,
+        sampler: &Sampler,
+        u: usize,
+    ) -> [<Scalar as Lanes>::F32; 4] {
         let (du_dx, du_dy) = Fragment::derivatives(self, u);
         let (dv_dx, dv_dy) = Fragment::derivatives(self, u + 1);
         let t = texture.sample_grad(
@@ -295,8 +385,9 @@ impl PbrShader<'_> {
         let one = f.lanes().splat_f32(1.0);
         let mut texels = [[one; 4]; SLOTS];
         let reads = &self.reads;
-        for (slot, texture, sampler) in reads.reads[..reads.count].iter().flatten() {
-            texels[*slot] = f.sample(texture, sampler);
+        for (slot, bound) in reads.reads[..reads.count].iter().flatten() {
+            let u = self.texcoord_varying(bound.texcoord);
+            texels[*slot] = f.sample(bound.texture, &bound.sampler, u);
         }
         texels
     }
@@ -323,9 +414,9 @@ impl PbrShader<'_> {
             lanes.splat_f32(factor.z),
             lanes.splat_f32(factor.w),
         ];
-        if self.vertex_colors {
+        if let Some(color) = self.layout.color {
             for (c, b) in base.iter_mut().enumerate() {
-                *b = *b * f.varying(at::COLOR + c);
+                *b = *b * f.varying(color + c);
             }
         }
         if self.textures.base_color.is_some() {
@@ -438,8 +529,8 @@ impl PbrShader<'_> {
 
     /// The shading normals of the material and of its clear coat: the interpolated normal,
     /// bent by the normal texture and by the coat's normal texture (each where the material has
-    /// one) in the derivative tangent frame ([`PbrShader::tangent_frame`]), flipped on back
-    /// faces of double-sided materials.
+    /// one) in the tangent frame ([`PbrShader::tangent_frame`]), flipped on back faces of
+    /// double-sided materials.
     #[inline(always)]
     fn normals<L: Lanes, F: Fragments<L>>(&self, f: &F, texels: &Texels<L>) -> [[L::F32; 3]; 2] {
         let lanes = f.lanes();
@@ -475,15 +566,32 @@ impl PbrShader<'_> {
         }
     }
 
+    /// The tangent frame `[t, b]` around `ng`: of the mesh's tangents where it has them
+    /// ([`PbrShader::vertex_tangent_frame`]), else from derivatives
+    /// ([`PbrShader::derivative_tangent_frame`]).
+    #[inline(always)]
+    fn tangent_frame<L: Lanes, F: Fragments<L>>(&self, f: &F, ng: [L::F32; 3]) -> [[L::F32; 3]; 2] {
+        match self.layout.tangent {
+            Some(tangent) => vertex_tangent_frame(f, ng, tangent),
+            None => self.derivative_tangent_frame(f, ng),
+        }
+    }
+
     /// The derivative tangent frame `[t, b]` around `ng`: `t_ = (∂v/∂y ∂p/∂x − ∂v/∂x ∂p/∂y) /
-    /// det` with `det = ∂u/∂x ∂v/∂y − ∂u/∂y ∂v/∂x`, `t = normalize(t_ − ng (ng·t_))` (0 where
+    /// det` with `det = ∂u/∂x ∂v/∂y − ∂u/∂y ∂v/∂x` (u, v: the coordinates of the
+    /// [frame texture](PbrShader::frame_texture)), `t = normalize(t_ − ng (ng·t_))` (0 where
     /// degenerate), `b = ±ng × t` (negative where the mapping is mirrored: `det < 0` on a front
     /// face, `det > 0` on a back face).
     #[inline(always)]
-    fn tangent_frame<L: Lanes, F: Fragments<L>>(&self, f: &F, ng: [L::F32; 3]) -> [[L::F32; 3]; 2] {
+    fn derivative_tangent_frame<L: Lanes, F: Fragments<L>>(
+        &self,
+        f: &F,
+        ng: [L::F32; 3],
+    ) -> [[L::F32; 3]; 2] {
         let lanes = f.lanes();
-        let (du_dx, du_dy) = f.derivatives(at::TEXCOORD);
-        let (dv_dx, dv_dy) = f.derivatives(at::TEXCOORD + 1);
+        let u = self.texcoord_varying(self.frame_texture().map_or(0, |b| b.texcoord));
+        let (du_dx, du_dy) = f.derivatives(u);
+        let (dv_dx, dv_dy) = f.derivatives(u + 1);
         let mut dp_dx = [lanes.splat_f32(0.0); 3];
         let mut dp_dy = dp_dx;
         for c in 0..3 {
@@ -495,20 +603,6 @@ impl PbrShader<'_> {
             (dv_dy * dp_dx[1] - dv_dx * dp_dy[1]) / det,
             (dv_dy * dp_dx[2] - dv_dx * dp_dy[2]) / det,
         ];
-        let along = ng[0] * t_[0] + ng[1] * t_[1] + ng[2] * t_[2];
-        let t = normalize3(
-            lanes,
-            [
-                t_[0] - ng[0] * along,
-                t_[1] - ng[1] * along,
-                t_[2] - ng[2] * along,
-            ],
-        );
-        let b = [
-            ng[1] * t[2] - ng[2] * t[1],
-            ng[2] * t[0] - ng[0] * t[2],
-            ng[0] * t[1] - ng[1] * t[0],
-        ];
         // Mirrored texture coordinates (the mapping turns the other way on screen than on a
         // face seen from its front) flip the bitangent.
         let zero = lanes.splat_f32(0.0);
@@ -518,12 +612,7 @@ impl PbrShader<'_> {
         } else {
             turned.not()
         };
-        let b = [
-            mirrored.select_f32(-b[0], b[0]),
-            mirrored.select_f32(-b[1], b[1]),
-            mirrored.select_f32(-b[2], b[2]),
-        ];
-        [t, b]
+        orthonormal_frame(lanes, ng, t_, mirrored)
     }
 
     #[inline(always)]
@@ -535,6 +624,56 @@ impl PbrShader<'_> {
             lanes.splat_f32(1.0),
         ]
     }
+}
+
+/// The tangent frame `[t, b]` of the mesh's interpolated tangent `t_` (world, varyings
+/// `tangent..tangent + 3`) and bitangent sign `w` (varying `tangent + 3`) around `ng`:
+/// `t = normalize(t_ − ng (ng·t_))` (0 where degenerate), `b = ng × t`, negated where `w < 0`.
+#[inline(always)]
+fn vertex_tangent_frame<L: Lanes, F: Fragments<L>>(
+    f: &F,
+    ng: [L::F32; 3],
+    tangent: usize,
+) -> [[L::F32; 3]; 2] {
+    let lanes = f.lanes();
+    let t_ = [
+        f.varying(tangent),
+        f.varying(tangent + 1),
+        f.varying(tangent + 2),
+    ];
+    let flipped = f.varying(tangent + 3).simd_lt(lanes.splat_f32(0.0));
+    orthonormal_frame(lanes, ng, t_, flipped)
+}
+
+/// `[t, b]` with `t = normalize(t_ − ng (ng·t_))` (0 where degenerate) and `b = ng × t`,
+/// negated in the lanes of `flip`.
+#[inline(always)]
+fn orthonormal_frame<L: Lanes>(
+    lanes: L,
+    ng: [L::F32; 3],
+    t_: [L::F32; 3],
+    flip: L::Mask,
+) -> [[L::F32; 3]; 2] {
+    let along = ng[0] * t_[0] + ng[1] * t_[1] + ng[2] * t_[2];
+    let t = normalize3(
+        lanes,
+        [
+            t_[0] - ng[0] * along,
+            t_[1] - ng[1] * along,
+            t_[2] - ng[2] * along,
+        ],
+    );
+    let b = [
+        ng[1] * t[2] - ng[2] * t[1],
+        ng[2] * t[0] - ng[0] * t[2],
+        ng[0] * t[1] - ng[1] * t[0],
+    ];
+    let b = [
+        flip.select_f32(-b[0], b[0]),
+        flip.select_f32(-b[1], b[1]),
+        flip.select_f32(-b[2], b[2]),
+    ];
+    [t, b]
 }
 
 /// `x` clamped to [0, 1] per lane (NaN gives 0).
@@ -590,27 +729,40 @@ fn bend<L: Lanes>(
 }
 
 impl Shader for PbrShader<'_> {
-    type Vertex = StandardVertex;
+    type Vertex = PbrVertex;
 
     fn varying_count(&self) -> usize {
         PbrShader::varying_count(self)
     }
 
+    /// World normal and position; then what the layout holds: the texture coordinate sets,
+    /// the world tangent (`model × xyz`, `w` negated under a mirroring `model`), the colour.
     #[inline]
-    fn vertex(&self, vertex: &StandardVertex, varyings: &mut [f32]) -> Vec4 {
-        let count = PbrShader::varying_count(self);
-        varyings[..count].fill(0.0);
-        let n = self.normal_matrix * vertex.normal;
+    fn vertex(&self, vertex: &PbrVertex, varyings: &mut [f32]) -> Vec4 {
+        let v = &vertex.standard;
+        let n = self.normal_matrix * v.normal;
         varyings[at::NORMAL..at::NORMAL + 3].copy_from_slice(&n.to_array());
-        let p = self.model.transform_point3(vertex.position);
+        let p = self.model.transform_point3(v.position);
         varyings[at::POSITION..at::POSITION + 3].copy_from_slice(&p.to_array());
-        if count > at::TEXCOORD {
-            varyings[at::TEXCOORD..at::TEXCOORD + 2].copy_from_slice(&vertex.texcoord.to_array());
+        let layout = &self.layout;
+        for (at, texcoord) in layout.texcoords.iter().zip([v.texcoord, vertex.texcoord1]) {
+            if let Some(at) = *at {
+                varyings[at..at + 2].copy_from_slice(&texcoord.to_array());
+            }
         }
-        if self.vertex_colors {
-            varyings[at::COLOR..at::COLOR + 4].copy_from_slice(&vertex.color.to_array());
+        if let Some(at) = layout.tangent {
+            let t = self.model.transform_vector3(vertex.tangent.truncate());
+            let w = if self.mirrored {
+                -vertex.tangent.w
+            } else {
+                vertex.tangent.w
+            };
+            varyings[at..at + 4].copy_from_slice(&t.extend(w).to_array());
         }
-        self.model_view_projection * vertex.position.extend(1.0)
+        if let Some(at) = layout.color {
+            varyings[at..at + 4].copy_from_slice(&v.color.to_array());
+        }
+        self.model_view_projection * v.position.extend(1.0)
     }
 
     fn fragment(&self, fragment: &Fragment<'_>) -> Option<Vec4> {

@@ -17,11 +17,11 @@ use kantele_rules::shade::texture::{ColorSpace, Filter, MinFilter, Wrap};
 struct OneAtATime<'s, 'a>(&'s PbrShader<'a>);
 
 impl Shader for OneAtATime<'_, '_> {
-    type Vertex = StandardVertex;
+    type Vertex = PbrVertex;
     fn varying_count(&self) -> usize {
         Shader::varying_count(self.0)
     }
-    fn vertex(&self, vertex: &StandardVertex, varyings: &mut [f32]) -> Vec4 {
+    fn vertex(&self, vertex: &PbrVertex, varyings: &mut [f32]) -> Vec4 {
         self.0.vertex(vertex, varyings)
     }
     fn fragment(&self, fragment: &Fragment<'_>) -> Option<Vec4> {
@@ -59,6 +59,15 @@ fn linear_texture(size: u32, texel: impl Fn(u32, u32) -> [u8; 4]) -> Texture {
     texture
 }
 
+/// `texture` bound through [`sampler`], reading the first texture coordinate set.
+fn bound(texture: &Texture) -> BoundTexture<'_> {
+    Some(Bound {
+        texture,
+        sampler: sampler(),
+        texcoord: 0,
+    })
+}
+
 fn sampler() -> Sampler {
     Sampler {
         wrap_s: Wrap::Repeat,
@@ -93,12 +102,12 @@ fn view_projection() -> Mat4 {
 }
 
 /// The colour of a 96 × 64 frame of `mesh` drawn with `shader`.
-fn render<S: Shader<Vertex = StandardVertex>>(
+fn render<S: Shader<Vertex = PbrVertex>>(
     shader: &S,
     mesh: &Mesh,
     options: RendererOptions,
 ) -> Vec<[f32; 4]> {
-    let (vertices, indices) = StandardVertex::from_mesh(mesh);
+    let (vertices, indices) = PbrVertex::from_mesh(mesh);
     let mut renderer = Renderer::new(96, 64, options).expect("renderer");
     let mut frame = renderer.begin_frame(Some(Vec4::ZERO), Some(1.0));
     frame
@@ -143,16 +152,16 @@ fn lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time() {
         ..Material::default()
     };
     let textures = PbrTextures {
-        base_color: Some((&base, sampler())),
-        emissive: Some((&base, sampler())),
-        metallic_roughness: Some((&mr, sampler())),
-        normal: Some((&bumps, sampler())),
-        occlusion: Some((&occlusion, sampler())),
-        specular: Some((&base, sampler())),
-        specular_color: Some((&occlusion, sampler())),
-        clearcoat: Some((&mr, sampler())),
-        clearcoat_roughness: Some((&occlusion, sampler())),
-        clearcoat_normal: Some((&bumps, sampler())),
+        base_color: bound(&base),
+        emissive: bound(&base),
+        metallic_roughness: bound(&mr),
+        normal: bound(&bumps),
+        occlusion: bound(&occlusion),
+        specular: bound(&base),
+        specular_color: bound(&occlusion),
+        clearcoat: bound(&mr),
+        clearcoat_roughness: bound(&occlusion),
+        clearcoat_normal: bound(&bumps),
     };
     let lighting = lighting(true);
     let model = Mat4::from_rotation_y(0.4) * Mat4::from_rotation_x(-0.3);
@@ -165,7 +174,7 @@ fn lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time() {
         Pass::Color,
         (1, 1),
     )
-    .with_vertex_colors(false);
+    .with_mesh_attributes(false, false);
     let mesh = quad();
     let reference = render(&shader, &mesh, RendererOptions::default());
     let covered = reference.iter().filter(|c| c[3] > 0.0).count();
@@ -215,13 +224,13 @@ fn a_normal_mapped_plane_shades_as_the_tilted_plane() {
             &lighting,
             &material,
             PbrTextures {
-                normal: Some((&map, sampler())),
+                normal: bound(&map),
                 ..PbrTextures::default()
             },
             Pass::Color,
             (1, 1),
         )
-        .with_vertex_colors(false);
+        .with_mesh_attributes(false, false);
         let plain = PbrShader::new(
             Mat4::IDENTITY,
             view_projection(),
@@ -231,7 +240,7 @@ fn a_normal_mapped_plane_shades_as_the_tilted_plane() {
             Pass::Color,
             (1, 1),
         )
-        .with_vertex_colors(false);
+        .with_mesh_attributes(false, false);
         let mut tilted_quad = quad();
         tilted_quad.normals = Some(vec![tilted; 4]);
         let a = render(&mapped, &quad(), RendererOptions::default());
@@ -266,13 +275,13 @@ fn the_normals_pass_writes_the_shading_normal() {
             &lighting,
             &material,
             PbrTextures {
-                normal: Some((&map, sampler())),
+                normal: bound(&map),
                 ..PbrTextures::default()
             },
             Pass::Normals,
             (1, 1),
         )
-        .with_vertex_colors(false)
+        .with_mesh_attributes(false, false)
     };
     let front = render(&shader(Mat4::IDENTITY), &quad(), RendererOptions::default());
     let n = front.iter().find(|c| c[3] > 0.0).expect("covered");
@@ -295,4 +304,155 @@ fn the_normals_pass_writes_the_shading_normal() {
     let n = back.iter().find(|c| c[3] > 0.0).expect("covered");
     assert!(n[2] > 0.5, "{n:?}");
     let _ = Arc::new(());
+}
+
+/// With the mesh's tangents the normal map bends in their frame: a plane whose map encodes a
+/// tilt `m` shades as the plane tilted to `t m.x + b m.y + n m.z`, with `b = w (n × t)`, for a
+/// tangent along +X (b = +Y: image up, the frame the derivatives give), a tangent along +Y
+/// (the tilt turns by 90°) and a negative `w` (b flips), also under a mirroring model matrix
+/// (which flips `w` back where it turns the plane's frame over).
+#[test]
+fn mesh_tangents_orient_the_normal_map() {
+    let lighting = lighting(false);
+    let (mx, my) = (0.45f32, -0.3f32);
+    let mz = (1.0 - mx * mx - my * my).sqrt();
+    let encode = |m: f32| ((m * 0.5 + 0.5) * 255.0).round() as u8;
+    let map = linear_texture(4, |_, _| [encode(mx), encode(my), encode(mz), 255]);
+    let decoded = |m: f32| encode(m) as f32 / 255.0 * 2.0 - 1.0;
+    let m = Vec3::new(decoded(mx), decoded(my), decoded(mz));
+    let material = Material {
+        metallic: 0.0,
+        roughness: 0.5,
+        ..Material::default()
+    };
+    let cases = [
+        (
+            Mat4::IDENTITY,
+            Vec4::new(1.0, 0.0, 0.0, 1.0),
+            Vec3::X,
+            Vec3::Y,
+        ),
+        (
+            Mat4::IDENTITY,
+            Vec4::new(0.0, 1.0, 0.0, 1.0),
+            Vec3::Y,
+            -Vec3::X,
+        ),
+        (
+            Mat4::IDENTITY,
+            Vec4::new(1.0, 0.0, 0.0, -1.0),
+            Vec3::X,
+            -Vec3::Y,
+        ),
+        // Mirrored in x: the world tangent is −X, the world normal stays +Z; the object's
+        // bitangent +Y stays +Y.
+        (
+            Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)),
+            Vec4::new(1.0, 0.0, 0.0, 1.0),
+            -Vec3::X,
+            Vec3::Y,
+        ),
+    ];
+    for (model, tangent, t, b) in cases {
+        let mut with_tangents = quad();
+        with_tangents.tangents = Some(vec![tangent; 4]);
+        let mapped = PbrShader::new(
+            model,
+            view_projection(),
+            &lighting,
+            &material,
+            PbrTextures {
+                normal: bound(&map),
+                ..PbrTextures::default()
+            },
+            Pass::Color,
+            (1, 1),
+        )
+        .with_mesh_attributes(false, true);
+        let plain = PbrShader::new(
+            Mat4::IDENTITY,
+            view_projection(),
+            &lighting,
+            &material,
+            PbrTextures::default(),
+            Pass::Color,
+            (1, 1),
+        )
+        .with_mesh_attributes(false, false);
+        let tilted = (t * m.x + b * m.y + Vec3::Z * m.z).normalize();
+        // The plain plane drawn with the model's mirror folded into its positions (the same
+        // pixels) and the expected normal.
+        let mut expected = quad();
+        for p in expected.positions.iter_mut() {
+            *p = model.transform_point3(*p);
+        }
+        expected.normals = Some(vec![tilted; 4]);
+        let a = render(&mapped, &with_tangents, RendererOptions::default());
+        let e = render(&plain, &expected, RendererOptions::default());
+        let mut worst = 0.0f32;
+        let mut covered = 0;
+        for (a, e) in a.iter().zip(&e) {
+            covered += usize::from(a[3] > 0.0);
+            for c in 0..3 {
+                worst = worst.max((a[c] - e[c]).abs());
+            }
+        }
+        assert!(covered > 1500, "{covered} pixels");
+        assert!(
+            worst < 2e-3,
+            "tangent {tangent} under {model}: differs by {worst}"
+        );
+    }
+}
+
+/// A texture bound to the second texture coordinate set reads it: the quad with its real
+/// coordinates in the second set and nonsense in the first draws as the quad textured through
+/// the first; the draw interpolates only the sets its textures read.
+#[test]
+fn textures_read_the_coordinate_set_they_are_bound_to() {
+    let lighting = lighting(true);
+    let checker = linear_texture(8, |x, y| {
+        if (x + y) % 2 == 0 {
+            [230, 40, 40, 255]
+        } else {
+            [20, 90, 200, 255]
+        }
+    });
+    let material = Material {
+        metallic: 0.0,
+        roughness: 0.6,
+        ..Material::default()
+    };
+    let shader = |set: u32| {
+        PbrShader::new(
+            Mat4::from_rotation_y(0.3),
+            view_projection(),
+            &lighting,
+            &material,
+            PbrTextures {
+                base_color: Some(Bound {
+                    texture: &checker,
+                    sampler: sampler(),
+                    texcoord: set,
+                }),
+                ..PbrTextures::default()
+            },
+            Pass::Color,
+            (1, 1),
+        )
+        .with_mesh_attributes(false, false)
+    };
+    assert_eq!(shader(0).varying_count(), at::OPTIONAL + 2);
+    let mut second = quad();
+    second.texcoords1 = second.texcoords.take();
+    second.texcoords = Some(vec![Vec2::splat(0.37); 4]);
+    let want = render(&shader(0), &quad(), RendererOptions::default());
+    let got = render(&shader(1), &second, RendererOptions::default());
+    let first_set = render(&shader(0), &second, RendererOptions::default());
+    assert!(want.iter().filter(|c| c[3] > 0.0).count() > 1500);
+    assert!(
+        got == want,
+        "the second set differs from the same coordinates in the first"
+    );
+    assert!(first_set != want, "the nonsense first set was read");
 }

@@ -477,6 +477,7 @@ mod tests {
                             min_filter: MinFilter::NearestMipmapLinear,
                             ..Sampler::default()
                         },
+                        texcoord: 0,
                     }),
                     ..Material::default()
                 },

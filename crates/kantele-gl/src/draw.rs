@@ -6,7 +6,7 @@ use glam::{Mat3, Mat4, Vec4};
 use glow::HasContext;
 use kantele_rules::backend::{FrameView, Pass};
 use kantele_rules::camera::normal_matrix;
-use kantele_rules::scene::{AlphaMode, Material, Scene, Shading, Topology};
+use kantele_rules::scene::{AlphaMode, Material, Mesh, Scene, Shading, TextureBinding, Topology};
 use kantele_rules::shade::pbr::PbrLighting;
 use kantele_rules::stats::FrameStats;
 use kantele_rules::RenderError;
@@ -178,7 +178,7 @@ impl GlBackend {
                     }
                 }
                 if pbr {
-                    self.set_pbr_draw_uniforms(draw, material, mesh.material);
+                    self.set_pbr_draw_uniforms(draw, material, mesh);
                 }
                 gl.active_texture(glow::TEXTURE0);
                 match material.base_color_texture {
@@ -211,27 +211,52 @@ impl GlBackend {
 }
 
 impl GlBackend {
-    /// The PBR program's uniforms and textures of one draw: the model matrix, the material's
-    /// metallic, roughness, normal scale and occlusion strength, and its metallic-roughness,
-    /// normal and occlusion textures on their units with the samplers of material
-    /// `material_index`.
+    /// The PBR program's uniforms and textures of one draw: the model matrix and whether it
+    /// mirrors, the material's metallic, roughness, normal scale and occlusion strength, its
+    /// PBR textures on their units with the samplers of the mesh's material, the texture
+    /// coordinate set of every texture, and whether the mesh has tangents.
     ///
     /// # Safety
     /// `self.gl` must be current on this thread with the PBR program in use; `material` must be
-    /// material `material_index` of the loaded scene (or its unlit copy), whose texture indices
+    /// the material of `mesh` in the loaded scene (or its unlit copy), whose texture indices
     /// were validated.
     unsafe fn set_pbr_draw_uniforms(
         &self,
         draw: &kantele_rules::scene::Draw,
         material: &Material,
-        material_index: usize,
+        mesh: &Mesh,
     ) {
         let gl = &self.gl;
         let u = &self.pbr_uniforms;
-        let samplers = self.gpu.pbr_samplers[material_index];
+        let samplers = self.gpu.pbr_samplers[mesh.material];
+        let mirrored = Mat3::from_mat4(draw.model).determinant() < 0.0;
+        let set = |b: Option<TextureBinding>| b.map_or(0, |b| b.texcoord as i32);
+        let mut sets = [
+            set(material.base_color_texture),
+            set(material.emissive_texture),
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+            0,
+        ];
+        for (k, binding) in material.pbr_textures().into_iter().enumerate() {
+            sets[2 + k] = set(binding);
+        }
+        let coat_normal = material
+            .clearcoat_normal_texture
+            .filter(|_| material.has_clearcoat());
+        let frame_set = set(material.normal_texture.or(coat_normal));
         // SAFETY: caller's contract; the textures and samplers are ours and alive.
         unsafe {
             gl.uniform_matrix_4_f32_slice(u.model.as_ref(), false, &draw.model.to_cols_array());
+            gl.uniform_1_f32(u.tangent_sign.as_ref(), if mirrored { -1.0 } else { 1.0 });
+            gl.uniform_1_i32_slice(u.texcoord_sets.as_ref(), &sets);
+            gl.uniform_1_i32(u.frame_set.as_ref(), frame_set);
+            gl.uniform_1_i32(u.has_tangents.as_ref(), mesh.tangents.is_some() as i32);
             gl.uniform_1_f32(u.metallic.as_ref(), material.metallic);
             gl.uniform_1_f32(u.roughness.as_ref(), material.roughness);
             gl.uniform_1_f32(u.normal_scale.as_ref(), material.normal_scale);

@@ -53,12 +53,15 @@ pub(crate) const UNIT_ENVIRONMENT: u32 = FIRST_PBR_UNIT + PBR_TEXTURES.len() as 
 /// Texture unit of the split-sum table.
 pub(crate) const UNIT_BRDF: u32 = UNIT_ENVIRONMENT + 1;
 
-/// The vertex shader: the Lambert program's, plus the world position for the fragment shader.
+/// The vertex shader: the Lambert program's, plus the world position, the second texture
+/// coordinate set and the world tangent (PbrShader's vertex stage) for the fragment shader.
 pub(crate) const VERTEX: &str = r#"#version 330 core
 layout(location = 0) in vec3 a_position;
 layout(location = 1) in vec3 a_normal;
 layout(location = 2) in vec2 a_texcoord;
 layout(location = 3) in vec4 a_color;
+layout(location = 4) in vec2 a_texcoord1;
+layout(location = 5) in vec4 a_tangent;
 
 // y-flipped projection × view × model (window row 0 = image row 0).
 uniform mat4 u_model_view_projection;
@@ -66,11 +69,15 @@ uniform mat4 u_model_view_projection;
 uniform mat3 u_normal_matrix;
 // The draw's model matrix (world position).
 uniform mat4 u_model;
+// -1 where the model matrix mirrors (the tangent's bitangent sign flips), else 1.
+uniform float u_tangent_sign;
 
 out vec3 v_normal;
 out vec2 v_texcoord;
 out vec4 v_color;
 out vec3 v_position;
+out vec2 v_texcoord1;
+out vec4 v_tangent;
 
 void main() {
     gl_Position = u_model_view_projection * vec4(a_position, 1.0);
@@ -78,6 +85,8 @@ void main() {
     v_texcoord = a_texcoord;
     v_color = a_color;
     v_position = (u_model * vec4(a_position, 1.0)).xyz;
+    v_texcoord1 = a_texcoord1;
+    v_tangent = vec4(mat3(u_model) * a_tangent.xyz, a_tangent.w * u_tangent_sign);
 }
 "#;
 
@@ -87,6 +96,17 @@ in vec3 v_normal;
 in vec2 v_texcoord;
 in vec4 v_color;
 in vec3 v_position;
+in vec2 v_texcoord1;
+in vec4 v_tangent;
+
+// The texture coordinate set (0 or 1) each texture reads, in the CPU shader's slot order:
+// base colour, emissive, metallic-roughness, normal, occlusion, specular, specular colour,
+// clear coat, clear-coat roughness, clear-coat normal.
+uniform int u_texcoord_set[10];
+// The set whose derivatives orient the tangent frame without mesh tangents.
+uniform int u_frame_set;
+// The mesh has tangents (else the derivative frame).
+uniform bool u_has_tangents;
 
 
 uniform vec4 u_base_color_factor;
@@ -444,6 +464,21 @@ vec3 shade(Surface s, vec3 emissive) {
     return color;
 }
 
+// The texture coordinates of the texture in slot k (u_texcoord_set).
+vec2 uv(int k) {
+    return u_texcoord_set[k] == 1 ? v_texcoord1 : v_texcoord;
+}
+
+// The tangent frame (t, b) around ng from t_ (orthonormal_frame): t = normalize(t_ - ng (ng.t_)),
+// b = ng x t, negated where flip.
+void orthonormal_frame(vec3 ng, vec3 t_, bool flip, out vec3 t, out vec3 b) {
+    t = normalize3(t_ - ng * dot3(ng, t_));
+    b = cross(ng, t);
+    if (flip) {
+        b = -b;
+    }
+}
+
 // The normal texture's texel bent into the tangent frame (t, b) around ng (PbrShader's bend).
 vec3 bend(vec3 t, vec3 b, vec3 ng, vec4 texel, float scale) {
     vec3 m = texel.rgb * 2.0 - 1.0;
@@ -493,50 +528,51 @@ void main() {
     // Texels are kantele's 8-bit mip chains (SRGB8_ALPHA8 or RGBA8), decoded to linear by GL.
     vec4 base = u_base_color_factor * v_color;
     if (u_has_texture) {
-        base *= texture(u_base_color_texture, v_texcoord);
+        base *= texture(u_base_color_texture, uv(0));
     }
     vec4 metallic_roughness = vec4(1.0);
     if (u_has_metallic_roughness_texture) {
-        metallic_roughness = texture(u_metallic_roughness_texture, v_texcoord);
+        metallic_roughness = texture(u_metallic_roughness_texture, uv(2));
     }
     vec4 occlusion_texel = vec4(1.0);
     if (u_has_occlusion_texture) {
-        occlusion_texel = texture(u_occlusion_texture, v_texcoord);
+        occlusion_texel = texture(u_occlusion_texture, uv(4));
     }
     vec4 normal_texel = vec4(0.5, 0.5, 1.0, 1.0);
     if (u_has_normal_texture) {
-        normal_texel = texture(u_normal_texture, v_texcoord);
+        normal_texel = texture(u_normal_texture, uv(3));
     }
     vec3 emissive = u_emissive;
     if (u_has_emissive_texture) {
-        emissive *= texture(u_emissive_texture, v_texcoord).rgb;
+        emissive *= texture(u_emissive_texture, uv(1)).rgb;
     }
     vec4 specular_texel = vec4(1.0);
     if (u_has_specular_texture) {
-        specular_texel = texture(u_specular_texture, v_texcoord);
+        specular_texel = texture(u_specular_texture, uv(5));
     }
     vec4 specular_color_texel = vec4(1.0);
     if (u_has_specular_color_texture) {
-        specular_color_texel = texture(u_specular_color_texture, v_texcoord);
+        specular_color_texel = texture(u_specular_color_texture, uv(6));
     }
     vec4 clearcoat_texel = vec4(1.0);
     if (u_has_clearcoat_texture) {
-        clearcoat_texel = texture(u_clearcoat_texture, v_texcoord);
+        clearcoat_texel = texture(u_clearcoat_texture, uv(7));
     }
     vec4 clearcoat_roughness_texel = vec4(1.0);
     if (u_has_clearcoat_roughness_texture) {
-        clearcoat_roughness_texel = texture(u_clearcoat_roughness_texture, v_texcoord);
+        clearcoat_roughness_texel = texture(u_clearcoat_roughness_texture, uv(8));
     }
     vec4 clearcoat_normal_texel = vec4(0.5, 0.5, 1.0, 1.0);
     if (u_has_clearcoat_normal_texture) {
-        clearcoat_normal_texel = texture(u_clearcoat_normal_texture, v_texcoord);
+        clearcoat_normal_texel = texture(u_clearcoat_normal_texture, uv(9));
     }
     // The projection is y-flipped (window row 0 = image row 0), so dFdy is the derivative
     // towards increasing image row, as the CPU's.
     vec3 dp_dx = dFdx(v_position);
     vec3 dp_dy = dFdy(v_position);
-    vec2 duv_dx = dFdx(v_texcoord);
-    vec2 duv_dy = dFdy(v_texcoord);
+    vec2 frame_uv = u_frame_set == 1 ? v_texcoord1 : v_texcoord;
+    vec2 duv_dx = dFdx(frame_uv);
+    vec2 duv_dy = dFdy(frame_uv);
 
     if (u_alpha_mode == 1 && base.a < u_alpha_cutoff) {
         discard;
@@ -560,22 +596,26 @@ void main() {
     bool coat = u_clearcoat > 0.0;
     vec3 coat_n = ng;
     if (u_has_normal_texture || (coat && u_has_clearcoat_normal_texture)) {
-        // The tangent from the screen-space derivatives of position and texture coordinate.
-        float du_dx = duv_dx.x;
-        float dv_dx = duv_dx.y;
-        float du_dy = duv_dy.x;
-        float dv_dy = duv_dy.y;
-        float det = du_dx * dv_dy - du_dy * dv_dx;
-        vec3 t_ = (dv_dy * dp_dx - dv_dx * dp_dy) / det;
-        vec3 t = normalize3(t_ - ng * dot3(ng, t_));
-        // A degenerate mapping (t zero or not finite) keeps the geometric normal.
-        if (t != vec3(0.0)) {
-            vec3 b = cross(ng, t);
+        vec3 t;
+        vec3 b;
+        if (u_has_tangents) {
+            // The mesh's tangent, its bitangent sign in w.
+            orthonormal_frame(ng, v_tangent.xyz, v_tangent.w < 0.0, t, b);
+        } else {
+            // The tangent from the screen-space derivatives of position and texture
+            // coordinate.
+            float du_dx = duv_dx.x;
+            float dv_dx = duv_dx.y;
+            float du_dy = duv_dy.x;
+            float dv_dy = duv_dy.y;
+            float det = du_dx * dv_dy - du_dy * dv_dx;
+            vec3 t_ = (dv_dy * dp_dx - dv_dx * dp_dy) / det;
             // Mirrored texture coordinates (the mapping turns the other way on screen than on
             // a face seen from its front) flip the bitangent.
-            if ((det < 0.0) != !gl_FrontFacing) {
-                b = -b;
-            }
+            orthonormal_frame(ng, t_, (det < 0.0) != !gl_FrontFacing, t, b);
+        }
+        // A degenerate frame (t zero or not finite) keeps the geometric normal.
+        if (t != vec3(0.0)) {
             if (u_has_normal_texture) {
                 n = bend(t, b, ng, normal_texel, u_normal_scale);
             }
@@ -694,6 +734,10 @@ pub(crate) struct PbrUniforms {
     pub(crate) clearcoat: Option<glow::UniformLocation>,
     pub(crate) clearcoat_roughness: Option<glow::UniformLocation>,
     pub(crate) clearcoat_normal_scale: Option<glow::UniformLocation>,
+    pub(crate) tangent_sign: Option<glow::UniformLocation>,
+    pub(crate) texcoord_sets: Option<glow::UniformLocation>,
+    pub(crate) frame_set: Option<glow::UniformLocation>,
+    pub(crate) has_tangents: Option<glow::UniformLocation>,
     pub(crate) eye: Option<glow::UniformLocation>,
     pub(crate) light_count: Option<glow::UniformLocation>,
     pub(crate) light_color: Option<glow::UniformLocation>,
@@ -743,6 +787,10 @@ pub(crate) unsafe fn pbr_uniforms(gl: &glow::Context, program: glow::Program) ->
         clearcoat: at("u_clearcoat"),
         clearcoat_roughness: at("u_clearcoat_roughness"),
         clearcoat_normal_scale: at("u_clearcoat_normal_scale"),
+        tangent_sign: at("u_tangent_sign"),
+        texcoord_sets: at("u_texcoord_set"),
+        frame_set: at("u_frame_set"),
+        has_tangents: at("u_has_tangents"),
         eye: at("u_eye"),
         light_count: at("u_punctual_count"),
         light_color: at("u_punctual_color"),

@@ -9,10 +9,13 @@ use kantele_rules::shade::environment::{
     brdf_table, Environment, BRDF_TABLE_SIZE, SPECULAR_LEVELS,
 };
 use kantele_rules::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
-use kantele_rules::vertex::StandardVertex;
+use kantele_rules::vertex::{PbrVertex, StandardVertex};
 
 /// Floats per vertex: position 3, normal 3, texcoord 2, colour 4.
 pub(crate) const VERTEX_FLOATS: usize = 12;
+/// Floats per vertex of a PBR scene: [`VERTEX_FLOATS`], then the second texcoord 2 and the
+/// tangent 4.
+pub(crate) const PBR_VERTEX_FLOATS: usize = VERTEX_FLOATS + 6;
 
 /// A mesh on the GPU.
 pub(crate) struct GpuMesh {
@@ -57,14 +60,31 @@ pub(crate) struct GpuEnvironment {
 /// ([`StandardVertex::from_mesh`]: attribute defaults, flat normals for meshes without any).
 pub(crate) fn interleave(mesh: &Mesh) -> (Vec<f32>, Vec<u32>) {
     let (vertices, indices) = StandardVertex::from_mesh(mesh);
+    let floats = vertices.iter().flat_map(standard_floats).collect();
+    (floats, indices)
+}
+
+/// Interleaved vertices of a PBR scene's mesh ([`PBR_VERTEX_FLOATS`] floats: those of
+/// [`interleave`], then the second texcoord and the tangent) and u32 indices, as the CPU
+/// backend prepares them ([`PbrVertex::from_mesh`]).
+pub(crate) fn interleave_pbr(mesh: &Mesh) -> (Vec<f32>, Vec<u32>) {
+    let (vertices, indices) = PbrVertex::from_mesh(mesh);
     let floats = vertices
         .iter()
         .flat_map(|v| {
-            let (p, n, t, c) = (v.position, v.normal, v.texcoord, v.color);
-            [p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y, c.x, c.y, c.z, c.w]
+            let (t1, t) = (v.texcoord1, v.tangent);
+            let mut floats = [0.0; PBR_VERTEX_FLOATS];
+            floats[..VERTEX_FLOATS].copy_from_slice(&standard_floats(&v.standard));
+            floats[VERTEX_FLOATS..].copy_from_slice(&[t1.x, t1.y, t.x, t.y, t.z, t.w]);
+            floats
         })
         .collect();
     (floats, indices)
+}
+
+fn standard_floats(v: &StandardVertex) -> [f32; VERTEX_FLOATS] {
+    let (p, n, t, c) = (v.position, v.normal, v.texcoord, v.color);
+    [p.x, p.y, p.z, n.x, n.y, n.z, t.x, t.y, c.x, c.y, c.z, c.w]
 }
 
 fn f32_bytes(values: impl IntoIterator<Item = f32>) -> Vec<u8> {
@@ -75,13 +95,33 @@ fn u32_bytes(values: &[u32]) -> Vec<u8> {
     values.iter().flat_map(|v| v.to_ne_bytes()).collect()
 }
 
-/// Uploads one mesh.
+/// Uploads one mesh, in the vertex layout of `shading`.
 ///
 /// # Safety
 /// `gl` must be current on this thread.
-pub(crate) unsafe fn upload_mesh(gl: &glow::Context, mesh: &Mesh) -> Result<GpuMesh, String> {
-    let (vertices, indices) = interleave(mesh);
-    let stride = (VERTEX_FLOATS * 4) as i32;
+pub(crate) unsafe fn upload_mesh(
+    gl: &glow::Context,
+    mesh: &Mesh,
+    shading: Shading,
+) -> Result<GpuMesh, String> {
+    // (location, floats, offset in floats) of each attribute.
+    let standard = [(0u32, 3i32, 0i32), (1, 3, 3), (2, 2, 6), (3, 4, 8)];
+    let (vertices, indices, floats, extra) = match shading {
+        Shading::Lambert => {
+            let (v, i) = interleave(mesh);
+            (v, i, VERTEX_FLOATS, &[][..])
+        }
+        Shading::Pbr => {
+            let (v, i) = interleave_pbr(mesh);
+            (
+                v,
+                i,
+                PBR_VERTEX_FLOATS,
+                &[(4u32, 2i32, 12i32), (5, 4, 14)][..],
+            )
+        }
+    };
+    let stride = (floats * 4) as i32;
     // SAFETY: the context is current (caller's contract); every handle used is created here, and
     // the byte slices outlive the calls that copy them.
     unsafe {
@@ -97,7 +137,7 @@ pub(crate) unsafe fn upload_mesh(gl: &glow::Context, mesh: &Mesh) -> Result<GpuM
             &u32_bytes(&indices),
             glow::STATIC_DRAW,
         );
-        for (location, size, offset) in [(0u32, 3i32, 0i32), (1, 3, 3), (2, 2, 6), (3, 4, 8)] {
+        for &(location, size, offset) in standard.iter().chain(extra) {
             gl.enable_vertex_attrib_array(location);
             gl.vertex_attrib_pointer_f32(location, size, glow::FLOAT, false, stride, offset * 4);
         }
@@ -367,7 +407,8 @@ impl GpuScene {
         let result = (|| {
             for (i, mesh) in scene.meshes.iter().enumerate() {
                 // SAFETY: forwarded caller's contract.
-                let m = unsafe { upload_mesh(gl, mesh) }.map_err(|e| format!("mesh {i}: {e}"))?;
+                let m = unsafe { upload_mesh(gl, mesh, scene.shading) }
+                    .map_err(|e| format!("mesh {i}: {e}"))?;
                 gpu.meshes.push(m);
             }
             for (i, texture) in scene.textures.iter().enumerate() {
@@ -473,6 +514,28 @@ mod tests {
             &v[VERTEX_FLOATS..2 * VERTEX_FLOATS],
             &[1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0]
         );
+    }
+
+    #[test]
+    fn interleave_pbr_appends_the_second_texcoord_and_the_tangent() {
+        let mesh = Mesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y],
+            normals: Some(vec![Vec3::Z; 3]),
+            texcoords1: Some(vec![glam::Vec2::new(0.25, 0.5); 3]),
+            tangents: Some(vec![glam::Vec4::new(1.0, 0.0, 0.0, -1.0); 3]),
+            indices: vec![0, 1, 2],
+            ..Mesh::default()
+        };
+        let (v, i) = interleave_pbr(&mesh);
+        let (standard, _) = interleave(&mesh);
+        assert_eq!(i, vec![0, 1, 2]);
+        assert_eq!(v.len(), 3 * PBR_VERTEX_FLOATS);
+        let second = &v[PBR_VERTEX_FLOATS..2 * PBR_VERTEX_FLOATS];
+        assert_eq!(
+            &second[..VERTEX_FLOATS],
+            &standard[VERTEX_FLOATS..2 * VERTEX_FLOATS]
+        );
+        assert_eq!(&second[VERTEX_FLOATS..], &[0.25, 0.5, 1.0, 0.0, 0.0, -1.0]);
     }
 
     #[test]

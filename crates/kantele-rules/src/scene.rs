@@ -22,8 +22,19 @@ pub struct Mesh {
     pub positions: Vec<Vec3>,
     /// Object-space normals, one per position; `None` means flat shading from face normals.
     pub normals: Option<Vec<Vec3>>,
-    /// Texture coordinates (`TEXCOORD_0`), one per position; (0, 0) is the image's top-left.
+    /// Texture coordinates, one per position; (0, 0) is the image's top-left. The first set
+    /// of the material's textures ([`TextureBinding::texcoord`] 0): the glTF loader stores
+    /// here the `TEXCOORD_n` set its first texture reads, with that texture's
+    /// `KHR_texture_transform` applied.
     pub texcoords: Option<Vec<Vec2>>,
+    /// A second set of texture coordinates, one per position, for the textures of the material
+    /// that read other coordinates than the first set ([`TextureBinding::texcoord`] 1).
+    pub texcoords1: Option<Vec<Vec2>>,
+    /// Object-space tangents for normal textures, one per position: the direction of
+    /// increasing u of the normal texture's coordinates in `xyz`, and in `w` (±1) the sign of
+    /// the bitangent `w × (normal × tangent)`. `None`: the shading derives a tangent frame from
+    /// screen-space derivatives.
+    pub tangents: Option<Vec<Vec4>>,
     /// Linear vertex colours (`COLOR_0`), RGBA, one per position.
     pub colors: Option<Vec<Vec4>>,
     /// Index list: three indices per triangle, two per line, one per point.
@@ -66,6 +77,8 @@ impl Mesh {
             positions: Vec::with_capacity(n),
             normals: Some(Vec::with_capacity(n)),
             texcoords: self.texcoords.as_ref().map(|_| Vec::with_capacity(n)),
+            texcoords1: self.texcoords1.as_ref().map(|_| Vec::with_capacity(n)),
+            tangents: self.tangents.as_ref().map(|_| Vec::with_capacity(n)),
             colors: self.colors.as_ref().map(|_| Vec::with_capacity(n)),
             indices: (0..n as u32).collect(),
             topology: Topology::Triangles,
@@ -82,6 +95,12 @@ impl Mesh {
                 }
                 if let (Some(dst), Some(src)) = (&mut out.texcoords, &self.texcoords) {
                     dst.push(src.get(i as usize).copied().unwrap_or(Vec2::ZERO));
+                }
+                if let (Some(dst), Some(src)) = (&mut out.texcoords1, &self.texcoords1) {
+                    dst.push(src.get(i as usize).copied().unwrap_or(Vec2::ZERO));
+                }
+                if let (Some(dst), Some(src)) = (&mut out.tangents, &self.tangents) {
+                    dst.push(src.get(i as usize).copied().unwrap_or(Vec4::ZERO));
                 }
                 if let (Some(dst), Some(src)) = (&mut out.colors, &self.colors) {
                     dst.push(src.get(i as usize).copied().unwrap_or(Vec4::ONE));
@@ -122,6 +141,9 @@ pub struct TextureBinding {
     pub texture: usize,
     /// How it is sampled.
     pub sampler: Sampler,
+    /// Which of the mesh's sets of texture coordinates it reads: 0 [`Mesh::texcoords`],
+    /// 1 [`Mesh::texcoords1`].
+    pub texcoord: u32,
 }
 
 /// A material with the shading rules of the reference scenes.
@@ -144,8 +166,9 @@ pub struct Material {
     /// Linear emitted colour (`emissiveFactor` × `KHR_materials_emissive_strength`), added after
     /// lighting.
     pub emissive: Vec3,
-    /// sRGB emissive texture, multiplied into `emissive`; read with the base colour's
-    /// texture coordinates.
+    /// sRGB emissive texture, multiplied into `emissive`. Lambert shading reads it, as the
+    /// base colour texture, with the first texture coordinate set; PBR shading with its own
+    /// ([`TextureBinding::texcoord`]).
     pub emissive_texture: Option<TextureBinding>,
     /// `metallicFactor` (PBR shading; glTF default 1).
     pub metallic: f32,
@@ -611,6 +634,8 @@ impl Scene {
             let attribute_ok = |len: Option<usize>| len.is_none_or(|l| l == n);
             if !attribute_ok(mesh.normals.as_ref().map(Vec::len))
                 || !attribute_ok(mesh.texcoords.as_ref().map(Vec::len))
+                || !attribute_ok(mesh.texcoords1.as_ref().map(Vec::len))
+                || !attribute_ok(mesh.tangents.as_ref().map(Vec::len))
                 || !attribute_ok(mesh.colors.as_ref().map(Vec::len))
             {
                 return Err(RenderError::InvalidScene(format!(
@@ -651,6 +676,12 @@ impl Scene {
                         "material {i} refers to texture {} of {}",
                         binding.texture,
                         self.textures.len()
+                    )));
+                }
+                if binding.texcoord > 1 {
+                    return Err(RenderError::InvalidScene(format!(
+                        "material {i} reads texture coordinate set {} (meshes have 2)",
+                        binding.texcoord
                     )));
                 }
             }

@@ -73,6 +73,7 @@ mod shading;
 mod single_mesh;
 mod spec_gloss_texels;
 mod stl_loader;
+mod tangents;
 pub mod texture_util;
 mod uri;
 

@@ -114,6 +114,8 @@ mod tests {
             indices: vec![0, 1, 2, 0, 2, 3],
             material: 0,
             topology: kantele_rules::scene::Topology::Triangles,
+            texcoords1: None,
+            tangents: None,
         }
     }
 

@@ -199,6 +199,8 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
             indices,
             topology: Topology::Triangles,
             material,
+            texcoords1: None,
+            tangents: None,
         };
         if mesh.normals.is_none() {
             // De-indexed: one vertex (position, normal, texcoord, colour) per corner.

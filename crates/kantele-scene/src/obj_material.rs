@@ -309,6 +309,7 @@ impl Converter<'_, '_> {
         Ok(TextureBinding {
             texture,
             sampler: sampler(l.options),
+            texcoord: 0,
         })
     }
 
@@ -342,7 +343,11 @@ impl Converter<'_, '_> {
                     Err(ImageError::Budget(e) | ImageError::Decode(e)) => Err(e),
                 }
             })?;
-        Ok(TextureBinding { texture, sampler })
+        Ok(TextureBinding {
+            texture,
+            sampler,
+            texcoord: 0,
+        })
     }
 
     /// The base colour texture: `map_Kd`, with the alpha of `map_d` when there is one (the

@@ -4,7 +4,7 @@
 use std::sync::Arc;
 
 use crate::material::{Lighting, MaterialShader, StandardVertex};
-use crate::pbr_material::{PbrShader, PbrTextures};
+use crate::pbr_material::{Bound, PbrShader, PbrTextures};
 use crate::pipeline::{Indices, RenderState, Renderer, RendererOptions, Shader};
 use crate::raster::Strategy;
 use crate::rop::TargetFormat;
@@ -14,26 +14,62 @@ use kantele_rules::multisample::SampleCount;
 use kantele_rules::scene::{Mesh, Scene, Shading, Topology};
 use kantele_rules::shade::pbr::PbrLighting;
 use kantele_rules::stats::FrameStats;
+use kantele_rules::vertex::PbrVertex;
 
 /// Options of the CPU backend.
 pub type CpuOptions = RendererOptions;
 
-/// A mesh converted once, at load time, to the vertex layout the shaders read.
-struct PreparedMesh {
-    vertices: Vec<StandardVertex>,
+/// A mesh converted once, at load time, to the vertex layout `V` the shaders read.
+struct PreparedMesh<V> {
+    vertices: Vec<V>,
     indices: Vec<u32>,
     topology: Topology,
 }
 
-impl PreparedMesh {
-    fn new(mesh: &Mesh) -> Self {
-        let (vertices, indices) = StandardVertex::from_mesh(mesh);
+impl<V> PreparedMesh<V> {
+    fn new(mesh: &Mesh, convert: fn(&Mesh) -> (Vec<V>, Vec<u32>)) -> Self {
+        let (vertices, indices) = convert(mesh);
         Self {
             vertices,
             indices,
             topology: mesh.topology,
         }
     }
+}
+
+/// A scene's meshes in the vertex layout of its shading.
+enum PreparedMeshes {
+    /// Lambert scenes.
+    Standard(Vec<PreparedMesh<StandardVertex>>),
+    /// PBR scenes: also the second texture coordinate set and the tangents.
+    Pbr(Vec<PreparedMesh<PbrVertex>>),
+}
+
+impl PreparedMeshes {
+    fn new(scene: &Scene) -> Self {
+        match scene.shading {
+            Shading::Lambert => Self::Standard(
+                scene
+                    .meshes
+                    .iter()
+                    .map(|m| PreparedMesh::new(m, StandardVertex::from_mesh))
+                    .collect(),
+            ),
+            Shading::Pbr => Self::Pbr(
+                scene
+                    .meshes
+                    .iter()
+                    .map(|m| PreparedMesh::new(m, PbrVertex::from_mesh))
+                    .collect(),
+            ),
+        }
+    }
+}
+
+/// The error of a frame whose scene's meshes were prepared for another shading (the scene's
+/// shading is fixed when it is loaded, so this is an internal inconsistency).
+fn layout_mismatch() -> RenderError {
+    RenderError::InvalidScene("the scene's meshes were prepared for another shading".into())
 }
 
 /// Renders scenes with Kantele's CPU pipeline.
@@ -43,7 +79,7 @@ pub struct CpuBackend {
     samples: SampleCount,
     /// The target format of colour frames (normals and ids are always drawn into `f32`).
     target: TargetFormat,
-    scene: Option<(Arc<Scene>, Vec<PreparedMesh>)>,
+    scene: Option<(Arc<Scene>, PreparedMeshes)>,
     /// The rows frames are restricted to (`None`: whole frames).
     region: Option<std::ops::Range<u32>>,
 }
@@ -90,10 +126,10 @@ impl CpuBackend {
 /// Clears (the scene's clear colour in the colour pass, 0 in the others) and draws every draw
 /// of `scene` in its draw order, draw `i` with `shaders[i]` under the state `state` gives it
 /// (front faces by the draw's model matrix).
-fn draw_scene<S: Shader<Vertex = StandardVertex>>(
+fn draw_scene<S: Shader>(
     renderer: &mut Renderer,
     scene: &Scene,
-    meshes: &[PreparedMesh],
+    meshes: &[PreparedMesh<S::Vertex>],
     view: &FrameView,
     shaders: &[S],
     state: impl Fn(&S) -> RenderState,
@@ -127,11 +163,18 @@ impl CpuBackend {
         let Some((scene, meshes)) = &self.scene else {
             return Err(RenderError::InvalidScene("no scene loaded".into()));
         };
+        let PreparedMeshes::Pbr(meshes) = meshes else {
+            return Err(layout_mismatch());
+        };
         let view_projection = view.projection * view.view;
         let lighting = PbrLighting::for_frame(scene, view);
         let unlit = scene.unlit_materials();
         let bound = |b: Option<kantele_rules::scene::TextureBinding>| {
-            b.map(|b| (&*scene.textures[b.texture], b.sampler))
+            b.map(|b| Bound {
+                texture: &*scene.textures[b.texture],
+                sampler: b.sampler,
+                texcoord: b.texcoord,
+            })
         };
         let shaders: Vec<PbrShader<'_>> = scene
             .draws
@@ -160,7 +203,10 @@ impl CpuBackend {
                     view.pass,
                     (draw.node_index as u32 + 1, i as u32 + 1),
                 )
-                .with_vertex_colors(scene.meshes[draw.mesh].colors.is_some())
+                .with_mesh_attributes(
+                    scene.meshes[draw.mesh].colors.is_some(),
+                    scene.meshes[draw.mesh].tangents.is_some(),
+                )
             })
             .collect();
         draw_scene(&mut self.renderer, scene, meshes, view, &shaders, |s| {
@@ -215,7 +261,7 @@ impl Backend for CpuBackend {
 
     fn load(&mut self, scene: Arc<Scene>) -> Result<(), RenderError> {
         scene.validate()?;
-        let meshes = scene.meshes.iter().map(PreparedMesh::new).collect();
+        let meshes = PreparedMeshes::new(&scene);
         // Decoded texels for the lane-wide sampler, now rather than in the first frame.
         for texture in &scene.textures {
             texture.prepare_lane_sampling();
@@ -251,6 +297,9 @@ impl Backend for CpuBackend {
         if scene.shading == Shading::Pbr {
             return self.render_pbr(view);
         }
+        let PreparedMeshes::Standard(meshes) = meshes else {
+            return Err(layout_mismatch());
+        };
         let unlit = scene.unlit_materials();
         let shaders: Vec<MaterialShader<'_>> = scene
             .draws

@@ -101,6 +101,7 @@ fn blend_order_and_emission_agree_with_opengl() {
             emissive_texture: Some(TextureBinding {
                 texture: 0,
                 sampler,
+                texcoord: 0,
             }),
             ..Material::default()
         },

@@ -40,6 +40,8 @@ fn ground(extent: f32, eye: Vec3, target: Vec3, znear: f32, zfar: Option<f32>) -
         indices: vec![0, 1, 2, 0, 2, 3],
         topology: Topology::Triangles,
         material: 0,
+        texcoords1: None,
+        tangents: None,
     };
     Scene {
         file_cameras: Vec::new(),

@@ -272,6 +272,7 @@ fn binding(texture: usize) -> Option<TextureBinding> {
     Some(TextureBinding {
         texture,
         sampler: Sampler::default(),
+        texcoord: 0,
     })
 }
 
@@ -483,6 +484,85 @@ fn normal_textures_follow_the_rules() {
         let worst = check_every_pixel(&image, &view, &what, |p| expected(&lighting, &params, n, p));
         eprintln!("{what}: largest difference {worst:.2e}");
     }
+}
+
+/// The mesh's tangents orient the normal texture (`t = model × xyz`, `b = w (ng × t)`), and
+/// textures bound to the second texture coordinate set read it: the plane's first set points at
+/// one texel of a nearest-filtered base colour texture, its second set at another, and its
+/// tangent runs along +y with a negative sign.
+#[test]
+fn mesh_tangents_and_the_second_coordinate_set_follow_the_rules() {
+    let Some(mut gl) = gl_or_skip() else {
+        return;
+    };
+    let texel = [200u8, 100, 210, 255];
+    let nearest = Sampler {
+        mag_filter: kantele_rules::shade::texture::Filter::Nearest,
+        min_filter: kantele_rules::shade::texture::MinFilter::Nearest,
+        ..Sampler::default()
+    };
+    let set1 = |texture| {
+        Some(TextureBinding {
+            texture,
+            sampler: nearest,
+            texcoord: 1,
+        })
+    };
+    let material = Material {
+        base_color_texture: set1(0),
+        metallic: 0.0,
+        roughness: 0.5,
+        normal_texture: set1(1),
+        ..Material::default()
+    };
+    // Texels (0, 0) red and (1, 1) a pale blue; (1, 0) and (0, 1) black.
+    let colors: Vec<u8> = [
+        [255u8, 0, 0, 255],
+        [0, 0, 0, 255],
+        [0, 0, 0, 255],
+        [64, 128, 230, 255],
+    ]
+    .concat();
+    let base_texture =
+        Arc::new(Texture::from_rgba8(2, 2, &colors, ColorSpace::Linear).expect("texture"));
+    let mut scene = scene(
+        material,
+        vec![base_texture, constant_texture(texel)],
+        lights(),
+    );
+    scene.tonemap = Tonemap::None;
+    let mesh = &mut scene.meshes[0];
+    mesh.texcoords = Some(vec![Vec2::splat(0.25); 4]);
+    mesh.texcoords1 = Some(vec![Vec2::splat(0.75); 4]);
+    mesh.tangents = Some(vec![Vec4::new(0.0, 1.0, 0.0, -1.0); 4]);
+    let ng = plane_normal();
+    let t = model().transform_vector3(Vec3::Y).normalize();
+    let t = (t - ng * ng.dot(t)).normalize();
+    let b = -ng.cross(t);
+    let m = Vec3::new(
+        unorm(texel[0]) * 2.0 - 1.0,
+        unorm(texel[1]) * 2.0 - 1.0,
+        unorm(texel[2]) * 2.0 - 1.0,
+    );
+    let mapped = (t * m.x + b * m.y + ng * m.z).normalize();
+    let params = Params {
+        base: Vec3::new(unorm(64), unorm(128), unorm(230)),
+        metallic: 0.0,
+        roughness: 0.5,
+        ..Params::default()
+    };
+    let scene = Arc::new(scene);
+    let normals_view = frame(&scene, EYE, Pass::Normals);
+    let image = render(&mut gl, &scene, &normals_view);
+    let worst = check_every_pixel(&image, &normals_view, "tangents: normal pass", |_| mapped);
+    eprintln!("tangents, normal pass: largest difference {worst:.2e}");
+    let view = frame(&scene, EYE, Pass::Color);
+    let image = render(&mut gl, &scene, &view);
+    let lighting = PbrLighting::for_frame(&scene, &view);
+    let worst = check_every_pixel(&image, &view, "tangents, second set: colour", |p| {
+        expected(&lighting, &params, mapped, p)
+    });
+    eprintln!("tangents, second set, colour: largest difference {worst:.2e}");
 }
 
 /// Unlit materials skip the lighting, but their colour (base + emission) is exposed and tone

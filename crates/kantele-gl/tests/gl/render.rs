@@ -340,6 +340,7 @@ fn quadrant_texture(sampler: Sampler) -> (Scene, [Vec4; 4]) {
         base_color_texture: Some(TextureBinding {
             texture: 0,
             sampler,
+            texcoord: 0,
         }),
         unlit: true,
         ..Material::default()
@@ -580,6 +581,7 @@ fn minification_reads_the_uploaded_mip_levels() {
         base_color_texture: Some(TextureBinding {
             texture: 0,
             sampler,
+            texcoord: 0,
         }),
         unlit: true,
         ..Material::default()

@@ -66,6 +66,8 @@ pub fn cube_mesh(material: usize) -> Mesh {
         indices,
         material,
         topology: kantele_rules::scene::Topology::Triangles,
+        texcoords1: None,
+        tangents: None,
     }
 }
 
@@ -89,6 +91,7 @@ pub fn scene() -> (Scene, SceneInfo) {
         base_color_texture: Some(TextureBinding {
             texture: 0,
             sampler: trilinear_repeat(),
+            texcoord: 0,
         }),
         unlit: true,
         ..Material::default()

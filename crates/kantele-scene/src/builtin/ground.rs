@@ -37,6 +37,8 @@ fn ground_mesh(material: usize) -> Mesh {
         indices: vec![0, 1, 2, 0, 2, 3],
         material,
         topology: kantele_rules::scene::Topology::Triangles,
+        texcoords1: None,
+        tangents: None,
     }
 }
 
@@ -60,6 +62,8 @@ fn triangle_mesh(material: usize) -> Mesh {
         positions,
         material,
         topology: kantele_rules::scene::Topology::Triangles,
+        texcoords1: None,
+        tangents: None,
     }
 }
 
@@ -71,6 +75,7 @@ pub fn scene() -> (Scene, SceneInfo) {
             base_color_texture: Some(TextureBinding {
                 texture: 0,
                 sampler: trilinear_repeat(),
+                texcoord: 0,
             }),
             unlit: true,
             ..Material::default()

@@ -190,6 +190,7 @@ pub fn lights() -> (Scene, SceneInfo) {
             normal_texture: Some(TextureBinding {
                 texture: 0,
                 sampler: trilinear_repeat(),
+                texcoord: 0,
             }),
             normal_scale: 1.0,
             ..Material::default()

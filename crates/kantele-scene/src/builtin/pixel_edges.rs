@@ -58,6 +58,8 @@ pub fn scene() -> (Scene, SceneInfo) {
         indices,
         material: 0,
         topology: kantele_rules::scene::Topology::Triangles,
+        texcoords1: None,
+        tangents: None,
     };
     let scene = Scene {
         file_cameras: Vec::new(),

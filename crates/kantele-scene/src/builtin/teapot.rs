@@ -114,6 +114,8 @@ pub fn teapot_mesh(material: usize) -> Mesh {
         indices,
         material,
         topology: kantele_rules::scene::Topology::Triangles,
+        texcoords1: None,
+        tangents: None,
     }
 }
 

@@ -15,8 +15,9 @@ use crate::uri::read_uri;
 use crate::LoadError;
 use kantele_rules::shade::texture::ColorSpace;
 
-/// Which texture coordinates a material's textures read: a `TEXCOORD_n` set and a
-/// `KHR_texture_transform` (applied to the mesh's coordinates at load).
+/// Which texture coordinates a texture reads: a `TEXCOORD_n` set and a
+/// `KHR_texture_transform`. The loader applies it to the coordinates of the meshes that use
+/// the material, which carry up to [`MESH_UV_MAPS`] such maps.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct UvMap {
     /// The `TEXCOORD_n` set.
@@ -24,6 +25,14 @@ pub(super) struct UvMap {
     /// The `KHR_texture_transform` (identity without one).
     pub(super) transform: Mat3,
 }
+
+/// How many different [`UvMap`]s a material's textures may read: the sets of texture
+/// coordinates a mesh carries ([`kantele_rules::scene::Mesh::texcoords`] and `texcoords1`).
+pub(super) const MESH_UV_MAPS: usize = 2;
+
+/// The maps of a material's textures, in the mesh's order: the first texture's first (the
+/// base colour's when it has one), then the next different one.
+pub(super) type MaterialUvMaps = [Option<UvMap>; MESH_UV_MAPS];
 
 /// A texture reference read from extension JSON (`{"index", "texCoord", "extensions":
 /// {"KHR_texture_transform"}}`): the file's texture and the coordinates it reads; `None` when
@@ -48,6 +57,12 @@ pub(super) fn json_texture_reference<'a>(
 }
 
 impl UvMap {
+    /// `TEXCOORD_0` as it is.
+    pub(super) const PLAIN: UvMap = UvMap {
+        set: 0,
+        transform: Mat3::IDENTITY,
+    };
+
     /// The map of a texture reference: its `texCoord` and its `KHR_texture_transform`
     /// extension value, if any.
     pub(super) fn of(tex_coord: u32, texture_transform: Option<&serde_json::Value>) -> Self {
@@ -151,7 +166,8 @@ enum TextureSource<'a> {
 
 impl<'a> Loader<'a> {
     /// Converts a material; also records which texture coordinates its textures read
-    /// (`self.material_uv`), which the loader bakes into the meshes that use it.
+    /// (`self.material_uv`), which the loader bakes into the meshes that use it, and whether
+    /// it bends normals (`self.material_normal_map`: which of those maps orients the tangents).
     pub(super) fn material(
         &mut self,
         material: &gltf::Material<'a>,
@@ -263,36 +279,44 @@ impl<'a> Loader<'a> {
             out.metallic = converted.metallic;
             out.roughness = converted.roughness;
         }
-        // The meshes carry one set of texture coordinates per material: the first texture's
-        // (the base colour's when it has one). A texture reading other coordinates is left out.
-        let mut first: Option<(UvMap, TextureSlot)> = None;
+        // The meshes carry up to MESH_UV_MAPS sets of texture coordinates per material: the
+        // first texture's (the base colour's when it has one), then the next different map's.
+        // A texture reading yet another map is left out.
+        let mut maps: MaterialUvMaps = [None; MESH_UV_MAPS];
+        let mut normal_map = None;
         for (slot, source, map) in refs {
             if material.unlit() && slot != TextureSlot::BaseColor {
                 // KHR_materials_unlit: every property but the base colour is a fallback for
                 // viewers without the extension.
                 continue;
             }
-            match first {
-                None => first = Some((map, slot)),
-                Some((first_map, first_slot)) if first_map != map => {
-                    self.info.warn(format!(
-                        "material '{name}': the {} texture reads other texture coordinates than the {} texture; it is left out",
-                        slot.name(),
-                        first_slot.name(),
-                    ));
-                    if slot == TextureSlot::Emissive {
-                        out.emissive = Vec3::ZERO;
-                    }
-                    continue;
+            let Some(set) = maps.iter().position(|m| m.is_none_or(|m| m == map)) else {
+                self.info.warn(format!(
+                    "material '{name}': the {} texture reads a third mapping of texture coordinates (set or transform); it is left out",
+                    slot.name(),
+                ));
+                if slot == TextureSlot::Emissive {
+                    out.emissive = Vec3::ZERO;
                 }
-                Some(_) => {}
-            }
+                continue;
+            };
+            maps[set] = Some(map);
             let binding = match source {
                 TextureSource::File(texture, color_space) => {
                     self.texture_binding(&texture, color_space)?
                 }
                 TextureSource::Made(binding) => Some(binding),
             };
+            let binding = binding.map(|b| TextureBinding {
+                texcoord: set as u32,
+                ..b
+            });
+            if binding.is_some()
+                && (slot == TextureSlot::Normal
+                    || (slot == TextureSlot::ClearcoatNormal && normal_map.is_none()))
+            {
+                normal_map = Some(set);
+            }
             match slot {
                 TextureSlot::BaseColor => out.base_color_texture = binding,
                 TextureSlot::Emissive => out.emissive_texture = binding,
@@ -306,7 +330,8 @@ impl<'a> Loader<'a> {
                 TextureSlot::ClearcoatNormal => out.clearcoat_normal_texture = binding,
             }
         }
-        self.material_uv.push(first.map(|(map, _)| map));
+        self.material_uv.push(maps);
+        self.material_normal_map.push(normal_map);
         out.alpha_mode = match material.alpha_mode() {
             gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
             gltf::material::AlphaMode::Mask => AlphaMode::Mask {
@@ -352,6 +377,7 @@ impl<'a> Loader<'a> {
         Ok(Some(TextureBinding {
             texture: texture_index,
             sampler: sampler_of(texture),
+            texcoord: 0,
         }))
     }
 

@@ -27,7 +27,7 @@ use crate::gltf_patch::{patch, split_glb, Patched};
 use crate::read_policy::{read_scene_file, ReadPolicy};
 use crate::uri::read_uri;
 use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
-use material::UvMap;
+use material::MaterialUvMaps;
 
 /// Extensions whose content the loader uses.
 pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
@@ -109,6 +109,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         primitive_meshes: HashMap::new(),
         default_material: None,
         material_uv: Vec::new(),
+        material_normal_map: Vec::new(),
         reference_extras: false,
         clear_color_given: false,
         rig: None,
@@ -263,7 +264,10 @@ struct Loader<'a> {
     /// Index of the appended default material, once one was needed.
     default_material: Option<usize>,
     /// Per file material: the texture coordinates its textures read.
-    material_uv: Vec<Option<UvMap>>,
+    material_uv: Vec<MaterialUvMaps>,
+    /// Per file material: which of its maps (`material_uv`) the normal texture reads, where it
+    /// bends normals: the meshes that use it get tangents for that map.
+    material_normal_map: Vec<Option<usize>>,
     /// The scene's extras carry `ambient`: a reference scene (Lambert by default).
     reference_extras: bool,
     /// The scene's extras give a clear colour.

@@ -8,7 +8,7 @@
 //! sequential `f32` arithmetic: the same time gives the same bits, and loading at a time gives
 //! the same scene as loading and then posing at that time.
 
-use glam::{Mat4, Quat, Vec3};
+use glam::{Mat4, Quat, Vec3, Vec4};
 use kantele_rules::scene::{Light, Scene};
 use thiserror::Error;
 
@@ -45,6 +45,8 @@ pub(crate) struct MorphDeltas {
     pub positions: Option<Vec<f32>>,
     /// NORMAL displacements, if the target has them and the mesh has normals.
     pub normals: Option<Vec<f32>>,
+    /// TANGENT displacements (of `xyz`), if the target has them and the mesh has tangents.
+    pub tangents: Option<Vec<f32>>,
 }
 
 /// A scene mesh that posing rewrites: one primitive of one node, morphed and perhaps skinned.
@@ -60,6 +62,8 @@ pub(crate) struct Deform {
     pub positions: Vec<Vec3>,
     /// Its normals, if it has them.
     pub normals: Option<Vec<Vec3>>,
+    /// Its tangents, if the file gives them and the material bends normals.
+    pub tangents: Option<Vec<Vec4>>,
     /// Its morph targets.
     pub targets: Vec<MorphDeltas>,
     /// For a mesh drawn flat-shaded (no normals in the file): the primitive's triangle list;
@@ -252,7 +256,12 @@ impl Rig {
             })?;
             let normals_ok = mesh.normals.as_ref().map(Vec::len)
                 == (deform.normals.is_some() || deform.corners.is_some()).then_some(expected);
-            if mesh.positions.len() != expected || !normals_ok {
+            let tangents_ok = match (&mesh.tangents, &deform.tangents) {
+                (Some(t), Some(_)) => t.len() == expected && deform.corners.is_none(),
+                (Some(_), None) | (None, Some(_)) => false,
+                (None, None) => true,
+            };
+            if mesh.positions.len() != expected || !normals_ok || !tangents_ok {
                 return Err(PoseError::Mismatch(format!(
                     "mesh {} has {} vertices, not {expected}",
                     deform.mesh,
@@ -312,6 +321,7 @@ impl Deform {
     ) {
         let mut positions = self.positions.clone();
         let mut normals = self.normals.clone();
+        let mut tangents = self.tangents.clone();
         for (target, &weight) in self.targets.iter().zip(weights) {
             if !morph::applies(weight) {
                 continue;
@@ -322,27 +332,41 @@ impl Deform {
             if let (Some(deltas), Some(normals)) = (&target.normals, normals.as_mut()) {
                 morph::add_target(normals, deltas, weight);
             }
+            if let (Some(deltas), Some(tangents)) = (&target.tangents, tangents.as_mut()) {
+                let mut directions: Vec<Vec3> = tangents.iter().map(|t| t.truncate()).collect();
+                morph::add_target(&mut directions, deltas, weight);
+                for (t, d) in tangents.iter_mut().zip(directions) {
+                    *t = d.extend(t.w);
+                }
+            }
         }
         if let Some((matrices, influences)) = joints {
-            let mut skinned = positions.clone();
-            let mut skinned_normals = normals.clone();
+            let mut skinned = skin::Skinned {
+                positions: positions.clone(),
+                normals: normals.clone(),
+                tangents: tangents.clone(),
+            };
             skin::skin(
                 influences,
                 matrices,
                 node_world,
                 &positions,
                 normals.as_deref(),
+                tangents.as_deref(),
                 &mut skinned,
-                skinned_normals.as_deref_mut(),
             );
-            positions = skinned;
-            normals = skinned_normals;
+            positions = skinned.positions;
+            normals = skinned.normals;
+            tangents = skinned.tangents;
         }
         let mesh = &mut scene.meshes[self.mesh];
         match &self.corners {
             None => {
                 mesh.positions.copy_from_slice(&positions);
                 if let (Some(dst), Some(src)) = (mesh.normals.as_mut(), normals) {
+                    dst.copy_from_slice(&src);
+                }
+                if let (Some(dst), Some(src)) = (mesh.tangents.as_mut(), tangents) {
                     dst.copy_from_slice(&src);
                 }
             }

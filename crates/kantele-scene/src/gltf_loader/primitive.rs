@@ -1,16 +1,17 @@
 //! Mesh primitives: attribute types and counts, morph targets, indices and topologies.
 
-use glam::{Mat3, Vec2, Vec3, Vec4};
+use glam::{Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
 use kantele_rules::scene::{Mesh, Topology};
 
+use super::material::UvMap;
 use super::{morph, named, Loader};
 use crate::accessor::{read_f32, read_u32, BufferData};
 use crate::mesh_util::{
     fan_to_list, first_index_out_of_range, flat_normals, line_strip_to_list, strip_to_list,
 };
-use crate::LoadError;
+use crate::{tangents, LoadError};
 
 impl Loader<'_> {
     /// Converts one primitive (triangles, lines or points) to a scene mesh.
@@ -21,21 +22,34 @@ impl Loader<'_> {
         weights: &[f32],
     ) -> Result<Option<usize>, LoadError> {
         let mut converted = self.primitive_mesh(mesh, primitive, weights)?;
+        let what = format!("mesh '{}' primitive {}", converted.name, primitive.index());
         if converted.normals.is_none() && converted.topology == Topology::Triangles {
-            // De-indexed: one vertex (position, normal, texcoord, colour) per corner.
-            let what = format!("mesh '{}' primitive {}", converted.name, primitive.index());
+            // De-indexed: one vertex (position, normal, texcoords, colour) per corner.
             self.budget
-                .charge(converted.indices.len() as u64, 48, &what)
+                .charge(converted.indices.len() as u64, 56, &what)
                 .map_err(|e| self.invalid(e))?;
             flat_normals(&mut converted);
+        }
+        if converted.tangents.is_none() {
+            if let Some(set) = self.normal_map_of(converted.material) {
+                tangents::generate(&mut converted, set, &mut self.budget, &what)
+                    .map_err(|e| self.invalid(e))?;
+            }
         }
         self.scene.meshes.push(converted);
         Ok(Some(self.scene.meshes.len() - 1))
     }
 
+    /// Which texture coordinate set of its meshes material `material` bends normals with
+    /// (its normal texture's), if it has a normal texture.
+    pub(super) fn normal_map_of(&self, material: usize) -> Option<usize> {
+        self.material_normal_map.get(material).copied().flatten()
+    }
+
     /// One primitive as a mesh with the given morph weights, indexed as in the file (lists),
-    /// without made-up normals: what [`Self::primitive`] adds to the scene, before flat
-    /// shading.
+    /// without made-up normals or tangents: what [`Self::primitive`] adds to the scene, before
+    /// flat shading and tangent generation. The file's tangents are read where the material
+    /// bends normals and the primitive has normals (glTF ignores tangents without them).
     pub(super) fn primitive_mesh(
         &mut self,
         mesh: &gltf::Mesh,
@@ -50,8 +64,10 @@ impl Loader<'_> {
             Some(m) => m,
             None => self.default_material(),
         };
-        let uv = self.material_uv.get(material).copied().flatten();
-        let uv_set = uv.map_or(0, |u| u.set);
+        let maps = self.material_uv.get(material).copied().unwrap_or_default();
+        // Without textures, TEXCOORD_0 as it is.
+        let maps = [Some(maps[0].unwrap_or(UvMap::PLAIN)), maps[1]];
+        let bends_normals = self.normal_map_of(material).is_some();
 
         let check = |semantic: &str,
                      accessor: &gltf::Accessor,
@@ -109,10 +125,22 @@ impl Loader<'_> {
         if let Some(a) = &normal_accessor {
             check("NORMAL", a, &normal_types, &[Dimensions::Vec3])?;
         }
-        let texcoord_name = format!("TEXCOORD_{uv_set}");
-        let texcoord_accessor = primitive.get(&Semantic::TexCoords(uv_set));
-        if let Some(a) = &texcoord_accessor {
-            check(&texcoord_name, a, &any_int, &[Dimensions::Vec2])?;
+        // Per map of the material: the accessor of its TEXCOORD_n set, with that name.
+        let mut texcoord_accessors = Vec::with_capacity(maps.len());
+        for map in maps.iter().flatten() {
+            let name = format!("TEXCOORD_{}", map.set);
+            let accessor = primitive.get(&Semantic::TexCoords(map.set));
+            if let Some(a) = &accessor {
+                check(&name, a, &any_int, &[Dimensions::Vec2])?;
+            }
+            texcoord_accessors.push((name, accessor, map.transform));
+        }
+        let tangent_accessor = match (&normal_accessor, bends_normals) {
+            (Some(_), true) => primitive.get(&Semantic::Tangents),
+            _ => None,
+        };
+        if let Some(a) = &tangent_accessor {
+            check("TANGENT", a, &normal_types, &[Dimensions::Vec4])?;
         }
         let color_accessor = primitive.get(&Semantic::Colors(0));
         if let Some(a) = &color_accessor {
@@ -159,18 +187,32 @@ impl Loader<'_> {
             ),
             None => None,
         };
-        let texcoords = match &texcoord_accessor {
-            Some(a) if a.count() != n => return Err(count_error(&texcoord_name, a.count())),
-            Some(a) => {
-                let transform = uv.map_or(Mat3::IDENTITY, |u| u.transform);
-                Some(
-                    read(&texcoord_name, a)
+        let mut texcoord_sets: Vec<Option<Vec<Vec2>>> = Vec::with_capacity(2);
+        for (name, accessor, transform) in &texcoord_accessors {
+            texcoord_sets.push(match accessor {
+                Some(a) if a.count() != n => return Err(count_error(name, a.count())),
+                Some(a) => Some(
+                    read(name, a)
                         .map_err(|e| LoadError::invalid(self.path, e))?
                         .chunks_exact(2)
                         .map(|t| transform.transform_point2(Vec2::from_slice(t)))
                         .collect::<Vec<_>>(),
-                )
-            }
+                ),
+                None => None,
+            });
+        }
+        let mut texcoord_sets = texcoord_sets.into_iter();
+        let texcoords = texcoord_sets.next().flatten();
+        let texcoords1 = texcoord_sets.next().flatten();
+        let mut tangents = match &tangent_accessor {
+            Some(a) if a.count() != n => return Err(count_error("TANGENT", a.count())),
+            Some(a) => Some(
+                read("TANGENT", a)
+                    .map_err(|e| LoadError::invalid(self.path, e))?
+                    .chunks_exact(4)
+                    .map(Vec4::from_slice)
+                    .collect::<Vec<_>>(),
+            ),
             None => None,
         };
         let (mut positions, mut normals) = (positions, normals);
@@ -193,6 +235,13 @@ impl Loader<'_> {
             apply(target.positions(), &mut positions, "morph target POSITION")?;
             if let Some(normals) = normals.as_mut() {
                 apply(target.normals(), normals, "morph target NORMAL")?;
+            }
+            if let Some(tangents) = tangents.as_mut() {
+                let mut directions: Vec<Vec3> = tangents.iter().map(|t| t.truncate()).collect();
+                apply(target.tangents(), &mut directions, "morph target TANGENT")?;
+                for (t, d) in tangents.iter_mut().zip(directions) {
+                    *t = d.extend(t.w);
+                }
             }
         }
         let colors = match &color_accessor {
@@ -263,6 +312,8 @@ impl Loader<'_> {
             positions,
             normals,
             texcoords,
+            texcoords1,
+            tangents,
             colors,
             indices,
             topology,

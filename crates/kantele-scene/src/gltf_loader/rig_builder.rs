@@ -179,6 +179,9 @@ impl Loader<'_> {
 
     /// Adds the mesh of one primitive of one node that posing rewrites (in its rest pose
     /// until [`Self::finish_rig`] poses it). Returns the mesh's index and whether it is skinned.
+    /// Tangents are the file's, morphed and skinned with the mesh; none are generated for a
+    /// deformed mesh (MikkTSpace's vertex splits would not follow the pose): without the
+    /// file's, its normal texture bends in the derivative frame.
     pub(super) fn deformable_primitive(
         &mut self,
         node: &gltf::Node,
@@ -220,7 +223,15 @@ impl Loader<'_> {
                 Some(_) => read(target.normals(), "NORMAL").map_err(invalid)?,
                 None => None,
             };
-            targets.push(MorphDeltas { positions, normals });
+            let tangents = match rest.tangents {
+                Some(_) => read(target.tangents(), "TANGENT").map_err(invalid)?,
+                None => None,
+            };
+            targets.push(MorphDeltas {
+                positions,
+                normals,
+                tangents,
+            });
         }
         let skin = match (node.skin(), &self.rig) {
             (Some(skin), Some(builder)) if has_influences(primitive) => {
@@ -238,9 +249,9 @@ impl Loader<'_> {
         // The scene's copy, as `primitive` would make it (flat-shaded without normals).
         let flat = rest.normals.is_none() && rest.topology == Topology::Triangles;
         let (count, each) = if flat {
-            (rest.indices.len() as u64, 52)
+            (rest.indices.len() as u64, 60)
         } else {
-            (n as u64, 48)
+            (n as u64, 72)
         };
         self.budget
             .charge(count, each, &what)
@@ -261,6 +272,7 @@ impl Loader<'_> {
                 skin,
                 positions: rest.positions,
                 normals: rest.normals,
+                tangents: rest.tangents,
                 targets,
                 corners,
             });

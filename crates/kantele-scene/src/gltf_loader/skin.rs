@@ -1,7 +1,9 @@
 //! Skinning on the CPU (glTF 2.0 §3.7.3): a vertex's joint influences (every `JOINTS_n` /
 //! `WEIGHTS_n` set of its primitive) and the skinned position
 //! `Σ wᵢ · (jointWorldᵢ · inverseBindMatrixᵢ) · v`, its normal by the inverse transpose of the
-//! same matrix, renormalised.
+//! same matrix and its tangent by the matrix itself, both renormalised; where the matrix mirrors
+//! (negative determinant) the tangent's bitangent sign flips, so the bitangent `w (n × t)`
+//! follows the matrix too.
 //!
 //! Weights are used as given (glTF asks exporters to normalise them; nothing is rescaled here).
 //! A vertex whose weights sum to zero, or that has a non-finite weight, has no defined skinned
@@ -155,31 +157,47 @@ pub(crate) fn normal_matrix(m: &Mat4) -> Mat3 {
     }
 }
 
-/// Skins `positions` (and `normals`, when given) into `out_positions` / `out_normals`:
+/// Where [`skin`] writes: positions, and normals and tangents where the mesh has them (each as
+/// long as the input).
+pub(crate) struct Skinned {
+    pub(crate) positions: Vec<Vec3>,
+    pub(crate) normals: Option<Vec<Vec3>>,
+    pub(crate) tangents: Option<Vec<Vec4>>,
+}
+
+/// Skins `positions` (and `normals` and `tangents`, when given) into `out`:
 /// `joint_matrices[j]` is joint `j`'s world matrix × its inverse bind matrix; vertices without a
 /// defined skinning matrix are moved by `fallback` (the skinned node's world matrix). Normals
-/// are renormalised (a normal that vanishes keeps its input value).
+/// and tangents are renormalised (one that vanishes keeps its input value); a tangent's sign
+/// flips where its matrix mirrors.
 pub(crate) fn skin(
     influences: &Influences,
     joint_matrices: &[Mat4],
     fallback: &Mat4,
     positions: &[Vec3],
     normals: Option<&[Vec3]>,
-    out_positions: &mut [Vec3],
-    mut out_normals: Option<&mut [Vec3]>,
+    tangents: Option<&[Vec4]>,
+    out: &mut Skinned,
 ) {
     let fallback_normals = normal_matrix(fallback);
     for (v, &p) in positions.iter().enumerate().take(influences.vertex_count()) {
         let skinned = influences.matrix(v, joint_matrices);
         let m = skinned.as_ref().unwrap_or(fallback);
-        out_positions[v] = m.transform_point3(p);
-        if let (Some(src), Some(dst)) = (normals, out_normals.as_deref_mut()) {
+        out.positions[v] = m.transform_point3(p);
+        if let (Some(src), Some(dst)) = (normals, out.normals.as_mut()) {
             let nm = match skinned {
                 Some(s) => normal_matrix(&s),
                 None => fallback_normals,
             };
             let n = src[v];
             dst[v] = (nm * n).try_normalize().unwrap_or(n);
+        }
+        if let (Some(src), Some(dst)) = (tangents, out.tangents.as_mut()) {
+            let t = src[v];
+            let direction = m.transform_vector3(t.truncate());
+            let mirrored = Mat3::from_mat4(*m).determinant() < 0.0;
+            let w = if mirrored { -t.w } else { t.w };
+            dst[v] = direction.try_normalize().unwrap_or(t.truncate()).extend(w);
         }
     }
 }
@@ -210,16 +228,29 @@ mod tests {
         let fallback = Mat4::from_translation(Vec3::new(0.0, 0.0, 10.0));
         let positions = [Vec3::ONE; 3];
         let normals = [Vec3::X; 3];
-        let mut out = [Vec3::ZERO; 3];
-        let mut out_n = [Vec3::ZERO; 3];
+        let tangents = [Vec4::new(0.0, 1.0, 0.0, -1.0); 3];
+        let mut skinned = Skinned {
+            positions: vec![Vec3::ZERO; 3],
+            normals: Some(vec![Vec3::ZERO; 3]),
+            tangents: Some(vec![Vec4::ZERO; 3]),
+        };
         skin(
             &inf,
             &joints,
             &fallback,
             &positions,
             Some(&normals),
-            &mut out,
-            Some(&mut out_n),
+            Some(&tangents),
+            &mut skinned,
+        );
+        let out = &skinned.positions;
+        let out_n = skinned.normals.as_ref().expect("normals");
+        let out_t = skinned.tangents.as_ref().expect("tangents");
+        // The rotated vertex's tangent turns with it and keeps its sign.
+        assert!(
+            (out_t[1] - Vec4::new(-1.0, 0.0, 0.0, -1.0)).length() < 1e-6,
+            "{}",
+            out_t[1]
         );
         assert_eq!(out[0], Vec3::new(2.0, 1.0, 1.0));
         assert!(
@@ -243,5 +274,37 @@ mod tests {
         let mirror = Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0));
         let n = (normal_matrix(&mirror) * Vec3::X).normalize();
         assert_eq!(n, -Vec3::X);
+    }
+
+    /// A mirroring joint matrix flips the tangent's bitangent sign: `w (n × t)` of the skinned
+    /// vectors is the mirrored bitangent.
+    #[test]
+    fn tangents_follow_the_matrix_and_flip_their_sign_when_mirrored() {
+        let inf = influences(vec![0, 0, 0, 0], vec![1.0, 0.0, 0.0, 0.0]);
+        let mirror = Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0));
+        let (n, t) = (Vec3::Z, Vec4::new(1.0, 0.0, 0.0, 1.0));
+        let mut skinned = Skinned {
+            positions: vec![Vec3::ZERO],
+            normals: Some(vec![Vec3::ZERO]),
+            tangents: Some(vec![Vec4::ZERO]),
+        };
+        skin(
+            &inf,
+            &[mirror],
+            &Mat4::IDENTITY,
+            &[Vec3::ZERO],
+            Some(&[n]),
+            Some(&[t]),
+            &mut skinned,
+        );
+        let n2 = skinned.normals.expect("normals")[0];
+        let t2 = skinned.tangents.expect("tangents")[0];
+        let bitangent = n2.cross(t2.truncate()) * t2.w;
+        let mirrored_bitangent = mirror.transform_vector3(n.cross(t.truncate()) * t.w);
+        assert!(
+            (bitangent - mirrored_bitangent).length() < 1e-6,
+            "{bitangent}"
+        );
+        assert_eq!(t2.truncate(), -Vec3::X);
     }
 }

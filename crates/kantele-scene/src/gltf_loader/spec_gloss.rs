@@ -148,10 +148,12 @@ impl<'a> Loader<'a> {
                 base_color: TextureBinding {
                     texture: base_color,
                     sampler: sampler(samplers.0, samplers.1),
+                    texcoord: 0,
                 },
                 metallic_roughness: TextureBinding {
                     texture: metallic_roughness,
                     sampler: sampler(samplers.1, samplers.0),
+                    texcoord: 0,
                 },
                 uv,
             }),

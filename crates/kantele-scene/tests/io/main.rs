@@ -25,4 +25,5 @@ mod reference_scenes;
 mod scene_choices;
 mod spec_gloss;
 mod srgb8_target;
+mod texture_coordinates;
 mod valid_files;
