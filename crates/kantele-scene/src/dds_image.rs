@@ -6,15 +6,15 @@
 //! follows it) is read and validated here; the texels are decoded by `image_dds` (pure Rust,
 //! blocks by `bcdec_rs`), one level at a time, every level's bytes checked against the file's
 //! length first. A panic of the decoder on corrupt data is caught and becomes this image's
-//! one-line error, never a crash of the process.
-//! Before anything is decoded the texture's size is checked against
-//! [`MAX_TEXTURE_SIZE`] and its decoded
-//! memory (every level it will decode) charged to the load's budget.
+//! one-line error, never a crash of the process. Before anything is decoded the texture's size
+//! is checked against [`MAX_TEXTURE_SIZE`] and its decoded memory (every level it will decode)
+//! charged to the load's budget.
 //!
 //! What is decoded, and how:
 //! - BC1 (`DXT1`), BC2 (`DXT3`), BC3 (`DXT5`) and BC7, as RGBA; BC4 (`ATI1`, `BC4U`, `BC4S`) as
 //!   grey (the one channel in red, green and blue), BC5 (`ATI2`, `BC5U`, `BC5S`) as red and
-//!   green with blue 0 (a two-channel normal map gets no rebuilt Z), BC6H clamped to 8 bits;
+//!   green with blue 0 (a two-channel normal map gets no rebuilt Z), unsigned BC6H clamped to
+//!   [0, 1] and truncated to 8 bits (signed BC6H is refused: the decoder reads it as unsigned);
 //! - 8-bit RGBA and BGRA, legacy (32-bit RGB masks) or DXGI, with alpha or without (`X8`
 //!   formats and legacy files without an alpha mask are opaque).
 //!
@@ -131,7 +131,7 @@ impl TexelFormat {
             | ImageFormat::Rgba8UnormSrgb
             | ImageFormat::Bgra8Unorm
             | ImageFormat::Bgra8UnormSrgb => w * h * 4,
-            // BC2, BC3, BC5, BC6H, BC7 (`from_dxgi` and `from_legacy` make no others).
+            // BC2, BC3, BC5, unsigned BC6H, BC7 (`from_dxgi` and `from_legacy` make no others).
             _ => blocks * 16,
         }
     }
@@ -157,7 +157,11 @@ impl TexelFormat {
             91 => Self::srgb(F::Bgra8UnormSrgb),
             93 => Self::srgb(F::Bgra8UnormSrgb).opaque(),
             94 | 95 => Self::new(F::BC6hRgbUfloat),
-            96 => Self::new(F::BC6hRgbSfloat),
+            96 => {
+                return Err(decode_error(
+                    "DDS DXGI format 96 (BC6H_SF16, signed HDR) is not supported",
+                ))
+            }
             97 | 98 => Self::new(F::BC7RgbaUnorm),
             99 => Self::srgb(F::BC7RgbaUnormSrgb),
             other => {
@@ -851,6 +855,7 @@ mod tests {
                 "premultiplied",
             ),
             (dds(2, 2, 1, Pixels::Dxgi(10), &[0; 32]), "DXGI format 10"),
+            (dds(4, 4, 1, Pixels::Dxgi(96), &[0; 16]), "BC6H_SF16"),
             (
                 dds(2, 2, 1, Pixels::FourCc(&[113, 0, 0, 0]), &[0; 32]),
                 "D3D format 113",
