@@ -45,6 +45,10 @@ pub enum RenderError {
         /// Elements given.
         actual: usize,
     },
+    /// A mip chain given level by level ([`crate::shade::texture::Texture::from_rgba8_levels`])
+    /// lacks levels, has too many, or has a level of the wrong size.
+    #[error("invalid mip chain: {0}")]
+    InvalidMipChain(String),
     /// An index refers past the end of the vertex buffer.
     #[error("index {index} at position {position} is out of range for {vertex_count} vertices")]
     IndexOutOfRange {

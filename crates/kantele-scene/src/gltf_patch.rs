@@ -9,7 +9,7 @@ use serde_json::Value;
 #[derive(Debug, Default)]
 pub(crate) struct Patched {
     /// Per glTF texture: the image it shows (`KHR_texture_basisu` first, then
-    /// `EXT_texture_webp`, then `source`), or
+    /// `MSFT_texture_dds`, then `EXT_texture_webp`, then `source`), or
     /// `None` when it has none that can be decoded.
     pub texture_images: Vec<Option<usize>>,
     /// The file's animations, taken out of the JSON (the loader reads the one it plays).
@@ -61,16 +61,15 @@ pub(crate) fn patch(root: &mut Value) -> Result<Patched, String> {
     if let Some(Value::Array(textures)) = object.get("textures") {
         for (t, texture) in textures.iter().enumerate() {
             let basisu = index(texture.pointer("/extensions/KHR_texture_basisu/source"));
+            let dds = index(texture.pointer("/extensions/MSFT_texture_dds/source"));
             let webp = index(texture.pointer("/extensions/EXT_texture_webp/source"));
             let source = index(texture.get("source"));
-            let chosen = basisu.or(webp).or(source);
+            let chosen = basisu.or(dds).or(webp).or(source);
             if chosen.is_none() {
-                for (ext, what) in [("EXT_texture_avif", "AVIF"), ("MSFT_texture_dds", "DDS")] {
-                    if texture.pointer(&format!("/extensions/{ext}")).is_some() {
-                        return Err(format!(
-                            "texture {t} uses {ext} ({what} images) without a fallback image, which this loader cannot decode"
-                        ));
-                    }
+                if texture.pointer("/extensions/EXT_texture_avif").is_some() {
+                    return Err(format!(
+                        "texture {t} uses EXT_texture_avif (AVIF images) without a fallback image, which this loader cannot decode"
+                    ));
                 }
                 patched
                     .warnings
@@ -115,11 +114,11 @@ mod tests {
         assert!(patch(&mut draco)
             .unwrap_err()
             .contains("KHR_draco_mesh_compression"));
-        let mut dds: Value = serde_json::from_str(
-            r#"{"images":[{"uri":"a.dds"}],"textures":[{"extensions":{"MSFT_texture_dds":{"source":0}}}]}"#,
+        let mut avif: Value = serde_json::from_str(
+            r#"{"images":[{"uri":"a.avif"}],"textures":[{"extensions":{"EXT_texture_avif":{"source":0}}}]}"#,
         )
         .unwrap();
-        assert!(patch(&mut dds).unwrap_err().contains("MSFT_texture_dds"));
+        assert!(patch(&mut avif).unwrap_err().contains("EXT_texture_avif"));
     }
 
     #[test]
@@ -141,5 +140,26 @@ mod tests {
         )
         .unwrap();
         assert!(patch(&mut bad).unwrap_err().contains("image 5"));
+    }
+
+    #[test]
+    fn dds_images_come_before_the_fallback() {
+        // The DDS image first, with or without a fallback in `source`; a KTX2 image before both.
+        let mut v: Value = serde_json::from_str(
+            r#"{"images":[{"uri":"a.png"},{"uri":"b.dds"},{"uri":"c.ktx2"}],
+                "textures":[{"source":0,"extensions":{"MSFT_texture_dds":{"source":1}}},
+                            {"extensions":{"MSFT_texture_dds":{"source":1}}},
+                            {"source":0,"extensions":{"MSFT_texture_dds":{"source":1},
+                                                      "KHR_texture_basisu":{"source":2}}}]}"#,
+        )
+        .unwrap();
+        let p = patch(&mut v).unwrap();
+        assert_eq!(p.texture_images, vec![Some(1), Some(1), Some(2)]);
+        assert!(p.warnings.is_empty());
+        let mut bad: Value = serde_json::from_str(
+            r#"{"images":[{"uri":"a.png"}],"textures":[{"source":0,"extensions":{"MSFT_texture_dds":{"source":7}}}]}"#,
+        )
+        .unwrap();
+        assert!(patch(&mut bad).unwrap_err().contains("image 7"));
     }
 }

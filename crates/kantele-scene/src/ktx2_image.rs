@@ -7,11 +7,14 @@
 //! process).
 //! Before anything is transcoded the texture's size is checked against
 //! [`MAX_TEXTURE_SIZE`](kantele_rules::shade::texture::MAX_TEXTURE_SIZE) and its decoded
-//! memory charged to the load's budget, and every level size the transcoder would allocate from
-//! the file is checked against the size the header implies.
+//! memory (every level it will decode) charged to the load's budget, and every level size the
+//! transcoder would allocate from the file is checked against the size the header implies.
 //!
-//! Level 0 is decoded; the texture builds its own mip chain from it (a [`Texture`] cannot take
-//! levels from a file), so the file's smaller levels are not read.
+//! A file that holds the complete mip chain (down to 1 × 1, every level of the size the chain
+//! rules give and of the byte length its format implies) has every level decoded and kept as
+//! the file gives it ([`Texture::from_rgba8_levels`]). Otherwise, or when a smaller level fails
+//! to decode, level 0 is decoded and the texture builds its own chain from it
+//! ([`Texture::from_rgba8`]); a file with only some of the smaller levels has them ignored.
 
 use kantele_rules::shade::texture::{ColorSpace, Texture, MAX_TEXTURE_SIZE};
 use ktx2::{Format, SupercompressionScheme, TransferFunction};
@@ -46,6 +49,15 @@ enum Content {
     Uastc,
     /// Uncompressed 8-bit texels with this many channels (3: RGB, 4: RGBA).
     Plain { channels: u32 },
+}
+
+/// What decodes a level: the Basis Universal transcoder (boxed: it is large), opened once for
+/// all levels, or the file's own uncompressed bytes.
+enum LevelDecoder<'a> {
+    /// ETC1S or UASTC.
+    Basis(Box<basisu::Transcoder<'a>>),
+    /// Uncompressed texels.
+    Plain,
 }
 
 /// A validated KTX2 file: its header facts, ready to decode.
@@ -131,10 +143,18 @@ impl<'a> Ktx2File<'a> {
         Ok(file)
     }
 
-    /// Level 0's bytes once decompressed, as the header implies them (`None` for ETC1S, whose
-    /// size is not fixed).
-    fn level0_size(&self) -> Option<u64> {
-        let (w, h) = (u64::from(self.width), u64::from(self.height));
+    /// The size of level `index` in texels: `max(1, width >> index)` × `max(1, height >>
+    /// index)`.
+    fn level_dimensions(&self, index: u32) -> (u32, u32) {
+        let halve = |size: u32| size.checked_shr(index).unwrap_or(0).max(1);
+        (halve(self.width), halve(self.height))
+    }
+
+    /// Level `index`'s bytes once decompressed, as the header implies them (`None` for ETC1S,
+    /// whose size is not fixed).
+    fn level_size(&self, index: u32) -> Option<u64> {
+        let (w, h) = self.level_dimensions(index);
+        let (w, h) = (u64::from(w), u64::from(h));
         match self.content {
             Content::Etc1s => None,
             Content::Uastc => Some(w.div_ceil(4) * h.div_ceil(4) * 16),
@@ -142,15 +162,23 @@ impl<'a> Ktx2File<'a> {
         }
     }
 
-    /// Checks level 0's recorded sizes against the header: the transcoder allocates a
-    /// Zstandard level's recorded uncompressed size as it is, so a wrong one is refused here.
+    /// Checks level 0's recorded sizes against the header (see [`Ktx2File::check_level`]).
     fn check_level0(&self) -> Result<(), ImageError> {
+        if self.reader.levels().len() == 0 {
+            return Err(decode_error("the KTX2 file has no image levels"));
+        }
+        self.check_level(0)
+    }
+
+    /// Checks level `index`'s recorded sizes against the header: the transcoder allocates a
+    /// Zstandard level's recorded uncompressed size as it is, so a wrong one is refused here.
+    fn check_level(&self, index: u32) -> Result<(), ImageError> {
         let level = self
             .reader
             .levels()
-            .next()
-            .ok_or_else(|| decode_error("the KTX2 file has no image levels"))?;
-        let Some(expected) = self.level0_size() else {
+            .nth(index as usize)
+            .ok_or_else(|| decode_error(format!("the KTX2 file has no level {index}")))?;
+        let Some(expected) = self.level_size(index) else {
             return Ok(());
         };
         let zstd = self.reader.header().supercompression_scheme.is_some();
@@ -160,12 +188,22 @@ impl<'a> Ktx2File<'a> {
             ("stored", level.data.len() as u64)
         };
         if actual != expected {
+            let (w, h) = self.level_dimensions(index);
             return Err(decode_error(format!(
-                "KTX2 level 0 holds {actual} {what} bytes, but a {}x{} image needs {expected}",
-                self.width, self.height
+                "KTX2 level {index} holds {actual} {what} bytes, but a {w}x{h} image needs {expected}"
             )));
         }
         Ok(())
+    }
+
+    /// How many levels the file's complete mip chain has, when it holds one (every level down
+    /// to 1 × 1, each of the size its format implies); `None` when it holds only level 0, some
+    /// of the levels, or levels of the wrong size.
+    fn complete_chain(&self) -> Option<u32> {
+        let full = 32 - self.width.max(self.height).leading_zeros();
+        let stored = u32::try_from(self.reader.levels().len()).ok()?;
+        (full > 1 && stored == full && (1..full).all(|i| self.check_level(i).is_ok()))
+            .then_some(full)
     }
 
     /// The colour space the file declares (its DFD transfer function), if it declares one.
@@ -186,27 +224,42 @@ impl<'a> Ktx2File<'a> {
             .is_some_and(|(_, value)| value.get(1) == Some(&b'u'))
     }
 
-    /// Level 0 as RGBA8, rows top first.
-    fn decode_rgba8(&self) -> Result<Vec<u8>, ImageError> {
-        let pixels = self.width as usize * self.height as usize;
-        let mut rgba = match self.content {
-            Content::Etc1s | Content::Uastc => caught("transcoder", || {
-                let transcoder = basisu::Transcoder::new(self.reader.data())?;
+    /// What decodes the file's levels: for Basis Universal, the transcoder opened on the file
+    /// (an error for a Basis Universal video).
+    fn level_decoder(&self) -> Result<LevelDecoder<'_>, ImageError> {
+        match self.content {
+            Content::Etc1s | Content::Uastc => {
+                let data = self.reader.data();
+                let transcoder =
+                    caught("transcoder", || basisu::Transcoder::new(data))?.map_err(|e| {
+                        decode_error(format!("cannot transcode KTX2: {}", basis_error(&e)))
+                    })?;
                 if transcoder.is_video() {
-                    return Ok(None);
+                    return Err(decode_error("the KTX2 file is a Basis Universal video"));
                 }
-                transcoder
-                    .transcode(0, basisu::TargetFormat::Rgba32, basisu::DecodeFlags::NONE)
-                    .map(Some)
+                Ok(LevelDecoder::Basis(Box::new(transcoder)))
+            }
+            Content::Plain { .. } => Ok(LevelDecoder::Plain),
+        }
+    }
+
+    /// Level `index` as RGBA8, rows top first.
+    fn decode_level(&self, decoder: &LevelDecoder<'_>, index: u32) -> Result<Vec<u8>, ImageError> {
+        let (width, height) = self.level_dimensions(index);
+        let mut rgba = match (decoder, self.content) {
+            (LevelDecoder::Basis(transcoder), _) => caught("transcoder", || {
+                transcoder.transcode(
+                    index,
+                    basisu::TargetFormat::Rgba32,
+                    basisu::DecodeFlags::NONE,
+                )
             })?
-            .map_err(|e| decode_error(format!("cannot transcode KTX2: {}", basis_error(&e))))?
-            .ok_or_else(|| decode_error("the KTX2 file is a Basis Universal video"))?,
-            Content::Plain { channels } => {
-                let level = self
-                    .reader
-                    .levels()
-                    .next()
-                    .ok_or_else(|| decode_error("the KTX2 file has no image levels"))?;
+            .map_err(|e| decode_error(format!("cannot transcode KTX2: {}", basis_error(&e))))?,
+            (LevelDecoder::Plain, Content::Plain { channels }) => {
+                let level =
+                    self.reader.levels().nth(index as usize).ok_or_else(|| {
+                        decode_error(format!("the KTX2 file has no level {index}"))
+                    })?;
                 let inflated;
                 let texels = match self.reader.header().supercompression_scheme {
                     Some(_) => {
@@ -224,19 +277,32 @@ impl<'a> Ktx2File<'a> {
                         .collect(),
                 }
             }
+            (LevelDecoder::Plain, _) => {
+                return Err(decode_error("Basis Universal data without its transcoder"))
+            }
         };
-        if rgba.len() != pixels * 4 {
+        if rgba.len() != width as usize * height as usize * 4 {
             return Err(decode_error(format!(
-                "the KTX2 decoder gave {} bytes for a {}x{} image",
+                "the KTX2 decoder gave {} bytes for a {width}x{height} image",
                 rgba.len(),
-                self.width,
-                self.height
             )));
         }
         if self.bottom_up() {
-            flip_rows(&mut rgba, self.width as usize * 4);
+            flip_rows(&mut rgba, width as usize * 4);
         }
         Ok(rgba)
+    }
+
+    /// The file's smaller levels, 1 to `count - 1`, as RGBA8 rows top first; `None` when one
+    /// of them does not decode.
+    fn decode_smaller_levels(
+        &self,
+        decoder: &LevelDecoder<'_>,
+        count: u32,
+    ) -> Option<Vec<Vec<u8>>> {
+        (1..count)
+            .map(|index| self.decode_level(decoder, index).ok())
+            .collect()
     }
 }
 
@@ -288,9 +354,10 @@ pub(crate) fn ktx2_size(bytes: &[u8]) -> Result<(u32, u32), ImageError> {
     Ok((file.width, file.height))
 }
 
-/// Decodes level 0 of a KTX2 image into a texture whose texels are encoded in `color_space`
-/// (decided by the texture's use, as for every image), after charging the texture's memory and
-/// the transcoder's to `budget`.
+/// Decodes a KTX2 image into a texture whose texels are encoded in `color_space` (decided by
+/// the texture's use, as for every image), after charging the texture's memory and the
+/// decoder's to `budget`: with the file's own mip levels when it holds the complete chain, else
+/// level 0 with a chain the texture builds.
 pub(crate) fn decode_ktx2(
     bytes: &[u8],
     color_space: ColorSpace,
@@ -298,16 +365,30 @@ pub(crate) fn decode_ktx2(
 ) -> Result<Texture, ImageError> {
     let file = Ktx2File::parse(bytes)?;
     let (width, height) = (file.width, file.height);
+    let chain = file.complete_chain();
+    // The decoded RGBA8 of every level read (4 bytes a texel, 4/3 of that with the smaller
+    // levels, rounded up), besides the texture and the transcoder's scratch.
+    let decoded_per_texel = if chain.is_some() { 6 } else { 4 };
     budget
         .charge(
             u64::from(width) * u64::from(height),
-            TEXTURE_BYTES_PER_TEXEL + 4 + TRANSCODER_SCRATCH_PER_TEXEL,
+            TEXTURE_BYTES_PER_TEXEL + decoded_per_texel + TRANSCODER_SCRATCH_PER_TEXEL,
             &format!("a {width}x{height} KTX2 texture"),
         )
         .map_err(ImageError::Budget)?;
-    let rgba = file.decode_rgba8()?;
-    Texture::from_rgba8(width, height, &rgba, color_space)
-        .map_err(|e| ImageError::Decode(e.to_string()))
+    let decoder = file.level_decoder()?;
+    let level0 = file.decode_level(&decoder, 0)?;
+    let to_error = |e: kantele_rules::error::RenderError| ImageError::Decode(e.to_string());
+    if let Some(smaller) = chain.and_then(|count| file.decode_smaller_levels(&decoder, count)) {
+        let levels: Vec<&[u8]> = std::iter::once(&level0[..])
+            .chain(smaller.iter().map(Vec::as_slice))
+            .collect();
+        // Checked level by level above; a chain the texture still refuses falls back too.
+        if let Ok(texture) = Texture::from_rgba8_levels(width, height, &levels, color_space) {
+            return Ok(texture);
+        }
+    }
+    Texture::from_rgba8(width, height, &level0, color_space).map_err(to_error)
 }
 
 /// A note when a KTX2 image declares another colour space (its transfer function) than the one

@@ -41,6 +41,19 @@ fn plain_ktx2(
     texels: &[u8],
     orientation: Option<&str>,
 ) -> Vec<u8> {
+    plain_ktx2_levels(format, width, height, &[texels], orientation)
+}
+
+/// A KTX2 file of an uncompressed `format` with `levels` as its levels, level 0 first (stored
+/// in the file smallest first, as the specification orders them) and, when given, a
+/// `KTXorientation` value.
+fn plain_ktx2_levels(
+    format: Format,
+    width: u32,
+    height: u32,
+    levels: &[&[u8]],
+    orientation: Option<&str>,
+) -> Vec<u8> {
     let (dfd, _) = ktx2::dfd::Basic::from_format(format).expect("a DFD for the format");
     let dfd = ktx2::dfd::Block::Basic(dfd).to_vec();
     let mut kvd = Vec::new();
@@ -52,31 +65,35 @@ fn plain_ktx2(
             kvd.push(0);
         }
     }
-    let dfd_offset = 80 + 24;
+    let dfd_offset = 80 + 24 * levels.len();
     let dfd_length = 4 + dfd.len();
     let kvd_offset = dfd_offset + dfd_length;
     let data_offset = kvd_offset + kvd.len();
     let mut out = KTX2_MAGIC.to_vec();
-    for word in [format.value(), 1, width, height, 0, 0, 1, 1, 0] {
+    let level_count = levels.len() as u32;
+    for word in [format.value(), 1, width, height, 0, 0, 1, level_count, 0] {
         out.extend_from_slice(&word.to_le_bytes());
     }
     let kvd_offset_field = if kvd.is_empty() { 0 } else { kvd_offset };
     for word in [dfd_offset, dfd_length, kvd_offset_field, kvd.len()] {
         out.extend_from_slice(&(word as u32).to_le_bytes());
     }
-    for long in [
-        0u64,
-        0,
-        data_offset as u64,
-        texels.len() as u64,
-        texels.len() as u64,
-    ] {
-        out.extend_from_slice(&long.to_le_bytes());
+    // No supercompression global data.
+    out.extend_from_slice(&[0; 16]);
+    // The level index, level 0 first; the data, smallest level first.
+    let mut offset = data_offset + levels.iter().map(|l| l.len()).sum::<usize>();
+    for level in levels {
+        offset -= level.len();
+        for long in [offset, level.len(), level.len()] {
+            out.extend_from_slice(&(long as u64).to_le_bytes());
+        }
     }
     out.extend_from_slice(&(dfd_length as u32).to_le_bytes());
     out.extend_from_slice(&dfd);
     out.extend_from_slice(&kvd);
-    out.extend_from_slice(texels);
+    for level in levels.iter().rev() {
+        out.extend_from_slice(level);
+    }
     out
 }
 
@@ -149,6 +166,19 @@ fn etc1s_decodes_to_the_reference_texels() {
         [229, 220, 88, 255],
     ];
     assert_eq!(quadrant_centres(&texture), expected);
+    // The file holds all six levels: the texture keeps the transcoder's, not its own averages.
+    let transcoder = basisu::Transcoder::new(ETC1S).unwrap();
+    for (index, level) in texture.levels().enumerate() {
+        let rgba = transcoder
+            .transcode(
+                index as u32,
+                basisu::TargetFormat::Rgba32,
+                basisu::DecodeFlags::NONE,
+            )
+            .unwrap();
+        let stored: Vec<u8> = level.texels.iter().flat_map(|t| t.to_le_bytes()).collect();
+        assert_eq!(stored, rgba, "level {index}");
+    }
     // ETC1S is lossy, but flat quadrants stay within a few units of their source colour.
     for (got, source) in expected.iter().zip(QUADRANTS) {
         for k in 0..3 {
@@ -204,6 +234,92 @@ fn uncompressed_rgba_and_rgb_decode_as_stored() {
     let texture = decode(&file, ColorSpace::Linear).unwrap();
     assert_eq!(texel(&texture, 24, 8), [40, 160, 60, 255]);
     assert_eq!(texel(&texture, 8, 24), [30, 60, 200, 255]);
+}
+
+/// `width` × `height` RGBA8 texels all of `colour`.
+fn flat(width: u32, height: u32, colour: [u8; 4]) -> Vec<u8> {
+    colour.repeat(width as usize * height as usize)
+}
+
+/// Every texel of level `index`, as RGBA bytes.
+fn level_texels(texture: &Texture, index: usize) -> Vec<[u8; 4]> {
+    let level = texture.level(index).expect("level");
+    level.texels.iter().map(|t| t.to_le_bytes()).collect()
+}
+
+const RED: [u8; 4] = [200, 0, 0, 255];
+const GREEN: [u8; 4] = [0, 180, 0, 255];
+const BLUE: [u8; 4] = [0, 0, 160, 128];
+
+#[test]
+fn a_complete_mip_chain_is_taken_from_the_file() {
+    let (l0, l1, l2) = (flat(4, 2, RED), flat(2, 1, GREEN), flat(1, 1, BLUE));
+    let file = plain_ktx2_levels(Format::R8G8B8A8_SRGB, 4, 2, &[&l0, &l1, &l2], None);
+    let texture = decode(&file, ColorSpace::Srgb).unwrap();
+    assert_eq!(texture.level_count(), 3);
+    // The file's levels as they are, not averages of level 0 (which would stay red).
+    assert_eq!(level_texels(&texture, 0), vec![RED; 8]);
+    assert_eq!(level_texels(&texture, 1), vec![GREEN; 2]);
+    assert_eq!(level_texels(&texture, 2), vec![BLUE]);
+    // RGB with its levels, bottom-up: each level's rows are turned over.
+    let rgb = |rgba: &[u8]| -> Vec<u8> {
+        rgba.chunks_exact(4)
+            .flat_map(|t| [t[0], t[1], t[2]])
+            .collect()
+    };
+    let mut l0 = flat(4, 2, RED);
+    l0[..16].copy_from_slice(&flat(4, 1, GREEN));
+    let file = plain_ktx2_levels(
+        Format::R8G8B8_UNORM,
+        4,
+        2,
+        &[&rgb(&l0), &rgb(&l1), &rgb(&l2)],
+        Some("ru"),
+    );
+    let texture = decode(&file, ColorSpace::Linear).unwrap();
+    assert_eq!(texel(&texture, 0, 0), RED);
+    assert_eq!(texel(&texture, 0, 1), GREEN);
+    assert_eq!(level_texels(&texture, 1), vec![GREEN; 2]);
+    assert_eq!(level_texels(&texture, 2), vec![[0, 0, 160, 255]]);
+}
+
+#[test]
+fn an_incomplete_or_wrongly_sized_chain_falls_back_to_level_0() {
+    let (l0, l1, l2) = (flat(4, 2, RED), flat(2, 1, GREEN), flat(1, 1, BLUE));
+    let built = |texture: &Texture| {
+        assert_eq!(texture.level_count(), 3);
+        assert_eq!(level_texels(texture, 0), vec![RED; 8]);
+        // Built from level 0: red again.
+        assert_eq!(level_texels(texture, 1), vec![RED; 2]);
+        assert_eq!(level_texels(texture, 2), vec![RED]);
+    };
+    // Two levels of three.
+    let file = plain_ktx2_levels(Format::R8G8B8A8_SRGB, 4, 2, &[&l0, &l1], None);
+    built(&decode(&file, ColorSpace::Srgb).unwrap());
+    // Level 1 of the wrong size.
+    let file = plain_ktx2_levels(Format::R8G8B8A8_SRGB, 4, 2, &[&l0, &l2, &l2], None);
+    built(&decode(&file, ColorSpace::Srgb).unwrap());
+    // Level 0 of the wrong size is still an error.
+    let file = plain_ktx2_levels(Format::R8G8B8A8_SRGB, 4, 2, &[&l1, &l1, &l2], None);
+    let e = decode(&file, ColorSpace::Srgb).unwrap_err();
+    assert!(e.contains("level 0 holds 8 stored bytes"), "{e}");
+}
+
+#[test]
+fn the_budget_pays_for_every_level_before_decoding() {
+    let (l0, l1, l2) = (flat(4, 2, RED), flat(2, 1, GREEN), flat(1, 1, BLUE));
+    let one = plain_ktx2_levels(Format::R8G8B8A8_SRGB, 4, 2, &[&l0], None);
+    let chain = plain_ktx2_levels(Format::R8G8B8A8_SRGB, 4, 2, &[&l0, &l1, &l2], None);
+    // What a one-level file of 8 texels is charged: the texture, the decoded level 0 and the
+    // transcoder's scratch. The chain's levels cost more, charged before anything is decoded.
+    let level0_charge = 8 * (TEXTURE_BYTES_PER_TEXEL + 4 + TRANSCODER_SCRATCH_PER_TEXEL);
+    let mut budget = Budget::new(level0_charge);
+    decode_ktx2(&one, ColorSpace::Srgb, &mut budget).expect("level 0 fits");
+    let mut budget = Budget::new(level0_charge);
+    match decode_ktx2(&chain, ColorSpace::Srgb, &mut budget) {
+        Err(ImageError::Budget(e)) => assert!(e.contains("4x2 KTX2 texture"), "{e}"),
+        other => panic!("the chain fitted the budget of level 0: {other:?}"),
+    }
 }
 
 #[test]

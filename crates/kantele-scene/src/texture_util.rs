@@ -47,12 +47,15 @@ pub(crate) fn image_size(bytes: &[u8], mime_type: Option<&str>) -> Result<(u32, 
     if crate::ktx2_image::is_ktx2(bytes, mime_type) {
         return crate::ktx2_image::ktx2_size(bytes);
     }
+    if crate::dds_image::is_dds(bytes, mime_type) {
+        return crate::dds_image::dds_size(bytes);
+    }
     reader(bytes, mime_type)?
         .into_dimensions()
         .map_err(|e| ImageError::Decode(format!("cannot decode image: {e}")))
 }
 
-/// Decodes an encoded PNG, JPEG, WebP or KTX2 image into a texture with its mip chain whose
+/// Decodes an encoded PNG, JPEG, WebP, KTX2 or DDS image into a texture with its mip chain whose
 /// texels are encoded in `color_space` (sRGB for colours, linear for data such as normals,
 /// metallic-roughness and occlusion), after reading its size from the header and charging the
 /// texture's memory to `budget`. The format is recognised from the data, `mime_type` is the
@@ -65,6 +68,9 @@ pub(crate) fn decode_within(
 ) -> Result<Texture, ImageError> {
     if crate::ktx2_image::is_ktx2(bytes, mime_type) {
         return crate::ktx2_image::decode_ktx2(bytes, color_space, budget);
+    }
+    if crate::dds_image::is_dds(bytes, mime_type) {
+        return crate::dds_image::decode_dds(bytes, color_space, budget);
     }
     let (width, height) = image_size(bytes, mime_type)?;
     let max = kantele_rules::shade::texture::MAX_TEXTURE_SIZE;

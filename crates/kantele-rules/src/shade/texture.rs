@@ -6,7 +6,8 @@
 //! chain takes 89.5 MB. sRGB textures keep their sRGB-encoded bytes, as OpenGL's
 //! `GL_SRGB8_ALPHA8`, and are decoded to linear through a 256-entry table *before* filtering.
 //! Mip levels are built by averaging 2 × 2 texels in linear space, then re-encoded (sRGB or
-//! linear) to 8 bits with round-to-nearest. Float images ([`Texture::from_rgba_f32`]) are
+//! linear) to 8 bits with round-to-nearest, unless the image brings its own complete chain
+//! ([`Texture::from_rgba8_levels`], for files that store their levels). Float images ([`Texture::from_rgba_f32`]) are
 //! quantised to linear 8 bits.
 //!
 //! Two samplers read that storage: the scalar [`Texture::sample_grad`] / [`Texture::sample_lod`]
@@ -175,11 +176,61 @@ impl Texture {
         Ok(Self::from_level0(width, height, level0, ColorSpace::Linear))
     }
 
-    fn from_level0(width: u32, height: u32, level0: Vec<u32>, color_space: ColorSpace) -> Self {
-        let mut sizes = vec![(width, height)];
-        while let Some(&(w, h)) = sizes.last().filter(|&&(w, h)| w > 1 || h > 1) {
-            sizes.push(((w / 2).max(1), (h / 2).max(1)));
+    /// Creates a texture from its complete mip chain of 8-bit RGBA levels (each row-major, row 0
+    /// = top row), encoded in `color_space` and kept as they are: for images whose file holds
+    /// its own smaller levels (KTX2, DDS), where [`Texture::from_rgba8`] would build them from
+    /// level 0 instead.
+    ///
+    /// `levels[0]` is `width` × `height` texels and level `i` is `max(1, width >> i)` ×
+    /// `max(1, height >> i)`, down to 1 × 1: the chain [`Texture::levels`] gives, one level per
+    /// entry, 4 bytes per texel. A level size outside `1..=MAX_TEXTURE_SIZE`, a chain with
+    /// another number of levels or a level with another byte length is an error
+    /// ([`RenderError::InvalidTextureSize`], [`RenderError::InvalidMipChain`]), and no texture
+    /// is made.
+    pub fn from_rgba8_levels(
+        width: u32,
+        height: u32,
+        levels: &[&[u8]],
+        color_space: ColorSpace,
+    ) -> Result<Self, RenderError> {
+        check_texture_size(width, height)?;
+        let sizes = chain_sizes(width, height);
+        if levels.len() != sizes.len() {
+            return Err(RenderError::InvalidMipChain(format!(
+                "a {width}x{height} texture has {} levels, {} given",
+                sizes.len(),
+                levels.len()
+            )));
         }
+        for (index, (level, &(w, h))) in levels.iter().zip(&sizes).enumerate() {
+            let expected = w as usize * h as usize * 4;
+            if level.len() != expected {
+                return Err(RenderError::InvalidMipChain(format!(
+                    "level {index} ({w}x{h}) holds {} bytes, expected {expected}",
+                    level.len()
+                )));
+            }
+        }
+        let total: usize = sizes.iter().map(|&(w, h)| w as usize * h as usize).sum();
+        let mut texels = Vec::with_capacity(total);
+        for level in levels {
+            texels.extend(
+                level
+                    .chunks_exact(4)
+                    .map(|p| pack_rgba8([p[0], p[1], p[2], p[3]])),
+            );
+        }
+        debug_assert_eq!(texels.len(), total);
+        Ok(Self {
+            texels,
+            levels: LevelTable::new(&sizes),
+            color_space,
+            linear15: OnceLock::new(),
+        })
+    }
+
+    fn from_level0(width: u32, height: u32, level0: Vec<u32>, color_space: ColorSpace) -> Self {
+        let sizes = chain_sizes(width, height);
         let total: usize = sizes.iter().map(|&(w, h)| w as usize * h as usize).sum();
         let levels = LevelTable::new(&sizes);
         let mut texels = level0;
@@ -352,6 +403,16 @@ impl Texture {
             }
         }
     }
+}
+
+/// The sizes of a complete mip chain whose level 0 is `width` × `height`: each level half the
+/// one before (rounded down, at least 1), down to 1 × 1.
+fn chain_sizes(width: u32, height: u32) -> Vec<(u32, u32)> {
+    let mut sizes = vec![(width, height)];
+    while let Some(&(w, h)) = sizes.last().filter(|&&(w, h)| w > 1 || h > 1) {
+        sizes.push(((w / 2).max(1), (h / 2).max(1)));
+    }
+    sizes
 }
 
 fn check_texture_size(width: u32, height: u32) -> Result<(), RenderError> {
@@ -686,6 +747,101 @@ mod tests {
         assert_eq!(sizes, vec![(5, 3), (2, 1), (1, 1)]);
         assert_eq!(odd.level(2).expect("level 2").texel(0, 0), Vec4::ONE);
         assert!(odd.level(3).is_none());
+    }
+
+    /// A `width` × `height` level of RGBA8 texels all `[value, 0, 0, 255]`.
+    fn flat_level(width: u32, height: u32, value: u8) -> Vec<u8> {
+        [value, 0, 0, 255].repeat(width as usize * height as usize)
+    }
+
+    #[test]
+    fn a_given_mip_chain_is_kept_as_it_is() {
+        // 4 × 2, 2 × 1, 1 × 1, each level a colour no average of the one above gives.
+        let levels = [
+            flat_level(4, 2, 10),
+            flat_level(2, 1, 200),
+            flat_level(1, 1, 77),
+        ];
+        let slices: Vec<&[u8]> = levels.iter().map(Vec::as_slice).collect();
+        for color_space in [ColorSpace::Srgb, ColorSpace::Linear] {
+            let t = Texture::from_rgba8_levels(4, 2, &slices, color_space).expect("texture");
+            assert_eq!((t.width(), t.height(), t.level_count()), (4, 2, 3));
+            assert_eq!(t.source_color_space(), color_space);
+            let sizes: Vec<(u32, u32)> = t.levels().map(|l| (l.width, l.height)).collect();
+            assert_eq!(sizes, vec![(4, 2), (2, 1), (1, 1)]);
+            for (level, red) in t.levels().zip([10, 200, 77]) {
+                assert!(level
+                    .texels
+                    .iter()
+                    .all(|&p| unpack_rgba8(p) == [red, 0, 0, 255]));
+            }
+            // The lane-wide sampler's copy is built from the given levels as from built ones.
+            t.prepare_lane_sampling();
+            let nearest = Sampler {
+                min_filter: MinFilter::NearestMipmapNearest,
+                mag_filter: Filter::Nearest,
+                ..Sampler::default()
+            };
+            let red = t.sample_lod(&nearest, Vec2::splat(0.5), 1.0).x;
+            let expected = level_red(&t, 1);
+            assert!((red - expected).abs() < 1e-6, "{red} vs {expected}");
+        }
+        // A single texel is a complete chain of one level.
+        let one = Texture::from_rgba8_levels(1, 1, &[&[1, 2, 3, 4]], ColorSpace::Linear)
+            .expect("texture");
+        assert_eq!(one.level_count(), 1);
+        assert_eq!(
+            unpack_rgba8(one.level(0).expect("level 0").texels[0]),
+            [1, 2, 3, 4]
+        );
+    }
+
+    /// Red of level `index`'s first texel, decoded.
+    fn level_red(t: &Texture, index: usize) -> f32 {
+        t.level(index).expect("level").texel(0, 0).x
+    }
+
+    #[test]
+    fn an_incomplete_or_wrongly_sized_chain_is_refused() {
+        let (l0, l1, l2) = (
+            flat_level(4, 2, 1),
+            flat_level(2, 1, 2),
+            flat_level(1, 1, 3),
+        );
+        let cases: [(&[&[u8]], &str); 5] = [
+            (&[&l0, &l1], "has 3 levels, 2 given"),
+            (&[&l0, &l1, &l2, &l2], "has 3 levels, 4 given"),
+            (&[], "has 3 levels, 0 given"),
+            (&[&l0, &l0, &l2], "level 1 (2x1) holds 32 bytes, expected 8"),
+            (
+                &[&l0, &l1, &l2[..3]],
+                "level 2 (1x1) holds 3 bytes, expected 4",
+            ),
+        ];
+        for (levels, message) in cases {
+            match Texture::from_rgba8_levels(4, 2, levels, ColorSpace::Srgb) {
+                Err(RenderError::InvalidMipChain(m)) => assert!(m.contains(message), "{m}"),
+                other => panic!("{message}: {other:?}"),
+            }
+        }
+        // Level 0 itself of the wrong length, and sizes outside the limit.
+        match Texture::from_rgba8_levels(4, 1, &[&l0, &l1, &l2], ColorSpace::Srgb) {
+            Err(RenderError::InvalidMipChain(m)) => {
+                assert!(
+                    m.contains("level 0 (4x1) holds 32 bytes, expected 16"),
+                    "{m}"
+                )
+            }
+            other => panic!("level 0 of the wrong length: {other:?}"),
+        }
+        assert!(matches!(
+            Texture::from_rgba8_levels(0, 4, &[], ColorSpace::Srgb),
+            Err(RenderError::InvalidTextureSize { .. })
+        ));
+        assert!(matches!(
+            Texture::from_rgba8_levels(MAX_TEXTURE_SIZE + 1, 1, &[], ColorSpace::Srgb),
+            Err(RenderError::InvalidTextureSize { .. })
+        ));
     }
 
     #[test]

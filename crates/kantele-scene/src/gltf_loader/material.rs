@@ -492,7 +492,9 @@ impl<'a> Loader<'a> {
                 size,
             }));
         }
-        if let Some(note) = crate::ktx2_image::color_space_note(&bytes, color_space) {
+        let note = crate::ktx2_image::color_space_note(&bytes, color_space)
+            .or_else(|| crate::dds_image::color_space_note(&bytes, color_space));
+        if let Some(note) = note {
             self.info.warn(format!("{what}: {note}"));
         }
         match decode_within(&bytes, mime_type.as_deref(), color_space, &mut self.budget) {

@@ -44,13 +44,14 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "EXT_texture_webp",
     "EXT_meshopt_compression",
     "KHR_texture_basisu",
+    "MSFT_texture_dds",
     "KHR_materials_variants",
     "KHR_draco_mesh_compression",
 ];
 
 /// Extensions that change how geometry or images are stored and that this loader cannot decode:
 /// requiring one is an error (using one without requiring it is refused where it is used).
-const UNREADABLE_EXTENSIONS: &[&str] = &["EXT_texture_avif", "MSFT_texture_dds"];
+const UNREADABLE_EXTENSIONS: &[&str] = &["EXT_texture_avif"];
 
 /// Default image size when the scene's extras give none.
 const DEFAULT_RESOLUTION: (u32, u32) = (800, 600);

@@ -1,7 +1,7 @@
 //! The fuzz targets on stable: every committed corpus file under `fuzz/corpus/<target>/`, then
 //! deterministic pseudo-random mutations of them, through the same bodies `cargo fuzz` runs
-//! (`kantele::fuzz_targets`, `kantele_testkit::fuzz_targets`, `kantele_scene::fuzz_ktx2`). A
-//! defect panics, failing the test.
+//! (`kantele::fuzz_targets`, `kantele_testkit::fuzz_targets`, `kantele_scene::fuzz_ktx2`,
+//! `kantele_scene::fuzz_dds`). A defect panics, failing the test.
 //!
 //! The seed files are generated, not hand-edited: `cargo test -p kantele-scene --test io
 //! -- --ignored write_seed_corpus` writes them (inputs the fuzzer found stay as they are).
@@ -188,6 +188,11 @@ fn ktx2_corpus_and_mutations() {
 }
 
 #[test]
+fn dds_corpus_and_mutations() {
+    replay("dds", 0x3c6e_f372_fe94_f82b, kantele_scene::fuzz_dds);
+}
+
+#[test]
 fn draco_corpus_and_mutations() {
     replay(
         "draco",
@@ -256,6 +261,22 @@ fn write_seed_corpus() {
         "quadrants-uastc-zstd.ktx2",
     ] {
         std::fs::copy(images.join(name), ktx2.join(format!("seed-{name}"))).expect("copy");
+    }
+
+    // dds: the DDS test images (tests/data/dds/README.md; written by the kantele-scene unit
+    // test `write_seed_files`).
+    let dds = corpus_dir("dds");
+    std::fs::create_dir_all(&dds).expect("corpus dir");
+    let images = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/dds");
+    let mut names: Vec<_> = std::fs::read_dir(&images)
+        .expect("tests/data/dds")
+        .map(|e| e.expect("entry").file_name())
+        .filter(|n| n.to_string_lossy().ends_with(".dds"))
+        .collect();
+    names.sort();
+    for name in names {
+        let seed = format!("seed-{}", name.to_string_lossy());
+        std::fs::copy(images.join(&name), dds.join(seed)).expect("copy");
     }
 
     // raster: width/height exponents, mode, strategy, then six little-endian u32 coordinates.

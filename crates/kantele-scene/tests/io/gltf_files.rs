@@ -378,15 +378,27 @@ fn unsupported_extensions_warn_and_unreadable_required_ones_fail() {
     assert_eq!(w.iter().filter(|w| w.contains("EXT_fancy")).count(), 2);
     assert_eq!(loaded.info.extensions_used.len(), 3);
 
-    g.json["extensionsUsed"] = json!(["MSFT_texture_dds"]);
+    // DDS images are decoded: requiring MSFT_texture_dds loads, with no warning naming it (the
+    // quad's texture has no DDS image here and keeps its PNG).
+    g.json["extensionsUsed"] = json!(["KHR_lights_punctual", "MSFT_texture_dds"]);
     g.json["extensionsRequired"] = json!(["MSFT_texture_dds"]);
     let path = dir.join("dds.glb");
     g.write_glb(&path);
+    let loaded = load(&path);
+    let w = &loaded.info.warnings;
+    assert!(w.iter().all(|w| !w.contains("MSFT_texture_dds")), "{w:?}");
+    assert_eq!(loaded.scene.textures.len(), 1);
+
+    // AVIF cannot be decoded: requiring it fails in one line naming the file and extension.
+    g.json["extensionsUsed"] = json!(["EXT_texture_avif"]);
+    g.json["extensionsRequired"] = json!(["EXT_texture_avif"]);
+    let path = dir.join("avif.glb");
+    g.write_glb(&path);
     let err = load_scene(&path)
-        .expect_err("DDS cannot be read")
+        .expect_err("AVIF cannot be read")
         .to_string();
     assert!(
-        err.contains("dds.glb") && err.contains("MSFT_texture_dds"),
+        err.contains("avif.glb") && err.contains("EXT_texture_avif"),
         "{err}"
     );
 }
