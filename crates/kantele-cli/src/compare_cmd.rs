@@ -43,9 +43,10 @@ pub fn run(args: &CompareArgs) -> Result<bool> {
         }
     }
     let inputs = scenes::inputs(&args.input)?;
-    if let Some(dir) = &args.out {
-        check_out_names(args, &inputs, dir)?;
-    }
+    let guard = match &args.out {
+        Some(dir) => Some(check_out_names(args, &inputs, dir)?),
+        None => None,
+    };
     let tol = Tolerances {
         max_coverage_diff: args.max_coverage_diff,
         max_mean_diff: args.max_mean_diff,
@@ -68,6 +69,9 @@ pub fn run(args: &CompareArgs) -> Result<bool> {
         let label = input.label();
         let stem = input.stem();
         let loaded = input.load()?;
+        if let Some(guard) = &guard {
+            guard.check_reads(&label, &loaded.info.files_read)?;
+        }
         warnings.report(&loaded, |w| eprintln!("{w}"));
         let scene = Arc::new(loaded.scene);
         let view = FrameView::of_scene(&scene);
@@ -138,8 +142,13 @@ pub fn run(args: &CompareArgs) -> Result<bool> {
 }
 
 /// Refuses, before rendering, `--out` files that would overwrite an input or each other (two
-/// scenes with one stem), and creates the folder.
-fn check_out_names(args: &CompareArgs, inputs: &[scenes::Input], dir: &Path) -> Result<()> {
+/// scenes with one stem), and creates the folder; the guard then checks each loaded scene's
+/// files.
+fn check_out_names(
+    args: &CompareArgs,
+    inputs: &[scenes::Input],
+    dir: &Path,
+) -> Result<crate::output_plan::OutputGuard> {
     let mut guard = crate::output_plan::OutputGuard::new(inputs);
     let n = args.backends.len();
     for input in inputs {
@@ -162,5 +171,6 @@ fn check_out_names(args: &CompareArgs, inputs: &[scenes::Input], dir: &Path) -> 
             }
         }
     }
-    crate::output_plan::create_folder(dir)
+    crate::output_plan::create_folder(dir)?;
+    Ok(guard)
 }

@@ -1,6 +1,11 @@
 //! Checks on output files made before anything is rendered: no two outputs the same file, no
 //! output overwriting an input (a scene file or a file it references), every output folder
 //! created and writable.
+//!
+//! The inputs are known twice: before any scene is loaded, from the files a `.gltf` or `.obj`
+//! names ([`input_files`], read only if they are small regular files), and after each load,
+//! exactly, from the files the loader read ([`OutputGuard::check_reads`]), which catches every
+//! form of reference (a `.glb`'s image URIs, `file://` URIs, MTL maps with options).
 
 use std::collections::HashMap;
 use std::path::{Component, Path, PathBuf};
@@ -47,8 +52,31 @@ pub fn identity(path: &Path) -> PathBuf {
     clean
 }
 
-/// Files an input reads: the scene file and, for `.gltf` and `.obj`, the files it names
-/// (buffers, images, MTL libraries and their texture maps) next to it.
+/// The most bytes of a `.gltf`, `.obj` or `.mtl` text [`input_files`] reads to find the files
+/// it names; a larger text is protected itself, and its references after loading.
+const LISTING_LIMIT: u64 = 64 << 20;
+
+/// The bytes of `path` if it is a regular file of at most [`LISTING_LIMIT`] bytes: never a
+/// device, FIFO or socket (opening a FIFO would wait for a writer), never more than the limit.
+fn read_listing(path: &Path) -> Option<Vec<u8>> {
+    use std::io::Read;
+    let meta = std::fs::metadata(path).ok()?;
+    if !meta.is_file() || meta.len() > LISTING_LIMIT {
+        return None;
+    }
+    let file = std::fs::File::open(path).ok()?;
+    // The path may have been swapped since: check what was opened.
+    if !file.metadata().ok()?.is_file() {
+        return None;
+    }
+    let mut bytes = Vec::new();
+    file.take(LISTING_LIMIT).read_to_end(&mut bytes).ok()?;
+    Some(bytes)
+}
+
+/// Files an input reads, as far as can be told before loading it: the scene file and, for
+/// `.gltf` and `.obj`, the files it names (buffers, images, MTL libraries and their texture
+/// maps) next to it.
 pub fn input_files(input: &Input) -> Vec<PathBuf> {
     let Input::File(path, _) = input else {
         return Vec::new();
@@ -57,7 +85,7 @@ pub fn input_files(input: &Input) -> Vec<PathBuf> {
     let dir = path.parent().unwrap_or(Path::new(""));
     match crate::output::extension(path).as_str() {
         "gltf" => {
-            let Ok(text) = std::fs::read_to_string(path) else {
+            let Some(text) = read_listing(path).and_then(|b| String::from_utf8(b).ok()) else {
                 return files;
             };
             let Ok(json) = serde_json::from_str::<serde_json::Value>(&text) else {
@@ -74,13 +102,13 @@ pub fn input_files(input: &Input) -> Vec<PathBuf> {
             }
         }
         "obj" => {
-            let Ok(bytes) = std::fs::read(path) else {
+            let Some(bytes) = read_listing(path) else {
                 return files;
             };
             let text = kantele_scene::obj_text(&bytes);
             for lib in names_after(&text, |k| k == "mtllib") {
                 let mtl = dir.join(&lib);
-                if let Ok(mtl_bytes) = std::fs::read(&mtl) {
+                if let Some(mtl_bytes) = read_listing(&mtl) {
                     let mtl_text = kantele_scene::obj_text(&mtl_bytes);
                     let mtl_dir = mtl.parent().unwrap_or(Path::new("")).to_path_buf();
                     for map in names_after(&mtl_text, is_texture_statement) {
@@ -186,6 +214,21 @@ impl OutputGuard {
                 path.display(),
                 earlier.display()
             );
+        }
+        Ok(())
+    }
+
+    /// Refuses outputs that would overwrite a file a loaded scene read (`files`: the loader's
+    /// [`files_read`](kantele_scene::SceneInfo::files_read)); `label` names the scene.
+    pub fn check_reads(&self, label: &str, files: &[PathBuf]) -> Result<()> {
+        for file in files {
+            if let Some(output) = self.outputs.get(&identity(file)) {
+                bail!(
+                    "{}: would overwrite {}, which {label} reads; choose another output name",
+                    output.display(),
+                    file.display()
+                );
+            }
         }
         Ok(())
     }

@@ -569,6 +569,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         let label = input.label();
         progress.set_message(input.stem());
         let mut loaded = input.load()?;
+        guard.check_reads(&label, &loaded.info.files_read)?;
         warnings.report(&loaded, |w| progress.suspend(|| eprintln!("{w}")));
         // The cameras frame the scene as loaded: at --time, or at the first time of a range.
         let (width, height) = cameras.image_size(&loaded, args.size, &label)?;

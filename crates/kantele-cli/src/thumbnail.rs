@@ -47,6 +47,7 @@ pub fn run(args: &ThumbnailArgs) -> Result<()> {
     }
     let label = input.label();
     let mut loaded = input.load()?;
+    guard.check_reads(&label, &loaded.info.files_read)?;
     loaded.scene.clear_color = glam::Vec4::ZERO;
     let plan = CameraPlan::new(
         &CameraArgs {

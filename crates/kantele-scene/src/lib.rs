@@ -162,6 +162,9 @@ pub struct SceneInfo {
     /// Index into [`SceneInfo::variants`] of the variant drawn ([`LoadOptions::variant`]);
     /// `None`: the default materials.
     pub variant_loaded: Option<usize>,
+    /// Every file the load read (canonical paths, in reading order): the scene file, its
+    /// buffers and images, MTL libraries and their maps. Empty for built-in scenes.
+    pub files_read: Vec<PathBuf>,
 }
 
 impl SceneInfo {
@@ -390,11 +393,14 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
     // The parsing crates are defensive but not panic-free on every malformed input (unchecked
     // `unreachable!`s, arithmetic on counts); a panic there must become a one-line error, not a
     // crash or a backtrace on stderr.
-    match quiet_panic::catch(|| loader(path, options)) {
+    let (result, files_read) =
+        read_policy::record_reads(|| quiet_panic::catch(|| loader(path, options)));
+    match result {
         Ok(Ok(mut loaded)) => {
             if let Some(cull) = options.cull {
                 override_culling(&mut loaded.scene, cull);
             }
+            loaded.info.files_read = files_read;
             loaded.info.finish();
             Ok(loaded)
         }

@@ -13,7 +13,7 @@ use crate::mtl_libraries::{MtlLibraries, MAX_LINE_WARNINGS};
 use crate::obj_material::{default_material, Converter};
 use crate::obj_text::{patch_obj, text, UNNAMED_MATERIAL};
 use crate::obj_textures::ObjTextures;
-use crate::obj_wide::{read_lines_points, ObjWide};
+use crate::obj_wide::{read_lines_points, vertex_color, ObjWide};
 use crate::read_policy::{read_scene_file, ReadPolicy};
 use crate::{LoadError, LoadOptions, LoadedScene, SceneInfo};
 
@@ -155,7 +155,7 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
         let colors = (m.vertex_color.len() == 3 * n).then(|| {
             m.vertex_color
                 .chunks_exact(3)
-                .map(|c| Vec4::new(c[0], c[1], c[2], 1.0))
+                .map(|c| vertex_color([c[0], c[1], c[2]]))
                 .collect::<Vec<_>>()
         });
         if let Some((position, index)) = first_index_out_of_range(&m.indices, n) {
@@ -208,6 +208,11 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
                 .charge(mesh.indices.len() as u64, 48, &what)
                 .map_err(|e| LoadError::invalid(path, e))?;
             flat_normals(&mut mesh);
+        }
+        if scene.materials[mesh.material].normal_texture.is_some() {
+            // MikkTSpace tangents for the normal map (the MTL's maps read the one set).
+            crate::tangents::generate(&mut mesh, 0, &mut budget, &what)
+                .map_err(|e| LoadError::invalid(path, e))?;
         }
         scene.meshes.push(mesh);
         scene.draws.push(Draw {

@@ -5,6 +5,7 @@
 //! lines or points) is read as one group of points, every vertex in file order.
 
 use glam::{Vec3, Vec4};
+use kantele_rules::color::srgb_to_linear;
 use kantele_rules::scene::Topology;
 
 use crate::obj_text::UNNAMED_MATERIAL;
@@ -59,7 +60,7 @@ pub(crate) fn read_lines_points(source: &str, all_points: bool) -> ObjWide {
                     .push(if w != 0.0 { position / w } else { position });
                 if values.len() == 6 {
                     any_color = true;
-                    colors.push(Vec4::new(value(3), value(4), value(5), 1.0));
+                    colors.push(vertex_color([value(3), value(4), value(5)]));
                 } else {
                     colors.push(Vec4::ONE);
                 }
@@ -130,6 +131,14 @@ pub(crate) fn read_lines_points(source: &str, all_points: bool) -> ObjWide {
     out.groups.retain(|g| !g.indices.is_empty());
     out.colors = any_color.then_some(colors);
     out
+}
+
+/// The colour of an OBJ vertex (`v x y z r g b`): sRGB-encoded values in [0, 1], as the tools
+/// that write them (MeshLab, ZBrush, Open3D) store display colours and as PLY's are read;
+/// clamped to [0, 1] and decoded to linear. Opaque.
+pub(crate) fn vertex_color(rgb: [f32; 3]) -> Vec4 {
+    let channel = |c: f32| srgb_to_linear(if c.is_nan() { 0.0 } else { c.clamp(0.0, 1.0) });
+    Vec4::new(channel(rgb[0]), channel(rgb[1]), channel(rgb[2]), 1.0)
 }
 
 #[cfg(test)]

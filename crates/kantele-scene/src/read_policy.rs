@@ -4,7 +4,12 @@
 //! symbolic links); [`LoadOptions::allow_read`](crate::LoadOptions::allow_read) adds folders.
 //! Devices, FIFOs, sockets and folders are never read, and a file larger than the memory budget
 //! allows is refused before it is read.
+//!
+//! Every file a load reads is recorded ([`record_reads`]): the command compares its outputs with
+//! them, so no output overwrites a file the scene was made from, whatever form its reference
+//! took (a relative URI, `file://`, an MTL map).
 
+use std::cell::RefCell;
 use std::io::Read;
 use std::path::{Path, PathBuf};
 
@@ -46,8 +51,34 @@ impl ReadPolicy {
     }
 }
 
+thread_local! {
+    /// The files read on this thread inside [`record_reads`], canonical; `None` outside it.
+    static READ_LOG: RefCell<Option<Vec<PathBuf>>> = const { RefCell::new(None) };
+}
+
+/// Runs `load` and returns, with its result, the canonical paths of every file it read through
+/// [`read_regular_file`] on this thread, in reading order, once each.
+pub(crate) fn record_reads<T>(load: impl FnOnce() -> T) -> (T, Vec<PathBuf>) {
+    let outer = READ_LOG.with(|log| log.borrow_mut().replace(Vec::new()));
+    let result = load();
+    let files = READ_LOG.with(|log| std::mem::replace(&mut *log.borrow_mut(), outer));
+    (result, files.unwrap_or_default())
+}
+
+/// Notes that `file` was read, when inside [`record_reads`].
+fn log_read(file: &Path) {
+    READ_LOG.with(|log| {
+        if let Some(files) = log.borrow_mut().as_mut() {
+            let real = std::fs::canonicalize(file).unwrap_or_else(|_| file.to_path_buf());
+            if !files.contains(&real) {
+                files.push(real);
+            }
+        }
+    });
+}
+
 /// Reads a regular file (never a device, FIFO or folder), charging its size to the budget
-/// before reading.
+/// before reading; the read is recorded ([`record_reads`]).
 pub(crate) fn read_regular_file(file: &Path, budget: &mut Budget) -> Result<Vec<u8>, String> {
     let meta = std::fs::metadata(file).map_err(|e| e.to_string())?;
     if !meta.is_file() {
@@ -66,6 +97,7 @@ pub(crate) fn read_regular_file(file: &Path, budget: &mut Budget) -> Result<Vec<
     f.take(meta.len())
         .read_to_end(&mut bytes)
         .map_err(|e| e.to_string())?;
+    log_read(file);
     Ok(bytes)
 }
 

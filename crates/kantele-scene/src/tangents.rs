@@ -239,7 +239,8 @@ mod tests {
     #[test]
     fn the_chosen_coordinate_set_orients_the_tangents() {
         let mut mesh = quad();
-        // u along −Y (down), v along −X: the tangent is −Y.
+        // u along +y and v along −x: the tangent is +y, and the bitangent (up the image, +x)
+        // is −(n × t), so w = −1.
         mesh.texcoords1 = Some(vec![
             Vec2::new(0.0, 1.0),
             Vec2::new(0.0, 0.0),
@@ -248,7 +249,7 @@ mod tests {
         ]);
         let mesh = generated(mesh, 1);
         for t in mesh.tangents.expect("tangents") {
-            assert!(t.truncate().abs_diff_eq(-Vec3::Y, 1e-6), "{t}");
+            assert!(t.abs_diff_eq(Vec4::new(0.0, 1.0, 0.0, -1.0), 1e-6), "{t}");
         }
     }
 

@@ -303,6 +303,115 @@ fn outputs_never_overwrite_inputs() {
     assert!(dir.path("new/deep/c.png.json").is_file());
 }
 
+/// A `.glb` of one triangle whose material's texture is the external image `uri`.
+fn glb_with_image_uri(uri: &str) -> Vec<u8> {
+    let positions: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+        .iter()
+        .flat_map(|f| f.to_le_bytes())
+        .collect();
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],
+"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}},"material":0}}]}}],
+"materials":[{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":0}}}}}}],
+"textures":[{{"source":0}}],"images":[{{"uri":"{uri}"}}],
+"buffers":[{{"byteLength":36}}],"bufferViews":[{{"buffer":0,"byteLength":36}}],
+"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}]}}"#
+    );
+    let mut json = json.into_bytes();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + 8 + positions.len();
+    let mut glb = Vec::new();
+    glb.extend(b"glTF");
+    glb.extend(2u32.to_le_bytes());
+    glb.extend((total as u32).to_le_bytes());
+    glb.extend((json.len() as u32).to_le_bytes());
+    glb.extend(b"JSON");
+    glb.extend(&json);
+    glb.extend((positions.len() as u32).to_le_bytes());
+    glb.extend(b"BIN\0");
+    glb.extend(&positions);
+    glb
+}
+
+/// Files the scene reads through references the command cannot see before loading (a `.glb`'s
+/// image URIs, `file://` URIs) are protected too: the output is refused after loading, before
+/// anything is written, and the file keeps its bytes.
+#[test]
+fn outputs_never_overwrite_what_the_loader_read() {
+    let dir = TempDir::new("loader-reads");
+    std::fs::write(dir.path("tex.png"), b"not really a png").unwrap();
+    std::fs::write(dir.path("t.glb"), glb_with_image_uri("tex.png")).unwrap();
+    let absolute = std::fs::canonicalize(dir.path("tex.png")).unwrap();
+    let file_uri = format!("file://{}", absolute.display());
+    std::fs::write(dir.path("u.glb"), glb_with_image_uri(&file_uri)).unwrap();
+    for (scene, command) in [
+        ("t.glb", "render"),
+        ("t.glb", "thumbnail"),
+        ("u.glb", "render"),
+    ] {
+        let o = match command {
+            "thumbnail" => kantele(&[command, &dir.s(scene), &dir.s("tex.png")]),
+            _ => kantele(&[command, &dir.s(scene), "-o", &dir.s("tex.png")]),
+        };
+        let e = err_line(&o);
+        assert!(
+            e.contains("would overwrite") && e.contains("reads"),
+            "{scene} {command}: {e}"
+        );
+        assert_eq!(
+            std::fs::read(dir.path("tex.png")).unwrap(),
+            b"not really a png",
+            "{scene} {command}"
+        );
+        assert!(!dir.path("tex.png.json").exists());
+    }
+}
+
+/// An `mtllib` naming a FIFO neither hangs the command's look at the inputs nor the load: the
+/// library is not a regular file, so it is not read.
+#[cfg(unix)]
+#[test]
+fn an_mtllib_fifo_does_not_hang() {
+    let dir = TempDir::new("mtl-fifo");
+    let status = Command::new("mkfifo")
+        .arg(dir.path("fifo.mtl"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    std::fs::write(
+        dir.path("f.obj"),
+        "mtllib fifo.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+    )
+    .unwrap();
+    let mut child = Command::new(BIN)
+        .args([
+            "render",
+            &dir.s("f.obj"),
+            "--size",
+            "16x16",
+            "-o",
+            &dir.s("f.png"),
+        ])
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait().unwrap() {
+            break status;
+        }
+        if start.elapsed() > Duration::from_secs(30) {
+            child.kill().unwrap();
+            panic!("render hangs on an mtllib FIFO");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    assert!(status.success(), "{status}");
+    assert!(dir.path("f.png").is_file());
+}
+
 #[cfg(unix)]
 #[test]
 fn interrupt_during_an_orbit_leaves_whole_sets_only() {

@@ -171,7 +171,7 @@ impl CpuBackend {
         let unlit = scene.unlit_materials();
         let bound = |b: Option<kantele_rules::scene::TextureBinding>| {
             b.map(|b| Bound {
-                texture: &*scene.textures[b.texture],
+                texture: &scene.textures[b.texture],
                 sampler: b.sampler,
                 texcoord: b.texcoord,
             })

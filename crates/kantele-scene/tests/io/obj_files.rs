@@ -582,3 +582,53 @@ fn tinyobjloader_texture_option_files() {
         );
     }
 }
+
+/// Vertex colours are sRGB-encoded display colours, as PLY's: decoded to linear (0.5 →
+/// 0.214), clamped to [0, 1] first; faces and point clouds alike.
+#[test]
+fn vertex_colours_are_decoded_from_srgb() {
+    let dir = write_files(
+        "obj-srgb-colours",
+        &[
+            (
+                "t.obj",
+                b"v 0 0 0 0.5 1.5 -1\nv 1 0 0 0.5 1.5 -1\nv 0 1 0 0.5 1.5 -1\nf 1 2 3\n",
+            ),
+            ("cloud.obj", b"v 0 0 0 0.5 0.5 0.5\nv 1 0 0 0.5 0.5 0.5\n"),
+        ],
+    );
+    let half = kantele::color::srgb_to_linear(0.5);
+    assert!((half - 0.214).abs() < 1e-3, "{half}");
+    for (file, want) in [
+        ("t.obj", Vec4::new(half, 1.0, 0.0, 1.0)),
+        ("cloud.obj", Vec4::new(half, half, half, 1.0)),
+    ] {
+        let loaded = load_scene(&dir.join(file)).expect("loads");
+        let colors = loaded.scene.meshes[0].colors.as_ref().expect("colours");
+        assert!(colors.iter().all(|c| *c == want), "{file}: {colors:?}");
+    }
+}
+
+/// A material with a normal map (`norm`) gives its meshes MikkTSpace tangents.
+#[test]
+fn normal_mapped_materials_get_tangents() {
+    let dir = write_files(
+        "obj-normal-map",
+        &[
+            (
+                "n.obj",
+                b"mtllib n.mtl\nusemtl bumpy\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 1 1\nvt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1 4/4/1\n",
+            ),
+            ("n.mtl", b"newmtl bumpy\nnorm bumps.png\n"),
+        ],
+    );
+    std::fs::write(dir.join("bumps.png"), test_png()).expect("write");
+    let loaded = load_scene(&dir.join("n.obj")).expect("loads");
+    let mesh = &loaded.scene.meshes[0];
+    let tangents = mesh.tangents.as_ref().expect("tangents");
+    assert_eq!(tangents.len(), mesh.positions.len());
+    // u along +x; OBJ's v runs up the image, so the bitangent n × t = +y needs w = +1.
+    for t in tangents {
+        assert!(t.abs_diff_eq(Vec4::new(1.0, 0.0, 0.0, 1.0), 1e-5), "{t}");
+    }
+}
