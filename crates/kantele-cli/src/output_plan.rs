@@ -162,7 +162,10 @@ fn percent_decode(uri: &str) -> String {
     let mut i = 0;
     while i < bytes.len() {
         if bytes[i] == b'%' && i + 2 < bytes.len() {
-            if let Ok(b) = u8::from_str_radix(&uri[i + 1..i + 3], 16) {
+            // Two hex digits as bytes: a multi-byte character after '%' is no escape (and
+            // slicing the text there would cut the character).
+            let hex = std::str::from_utf8(&bytes[i + 1..i + 3]).ok();
+            if let Some(b) = hex.and_then(|h| u8::from_str_radix(h, 16).ok()) {
                 out.push(b);
                 i += 3;
                 continue;
@@ -345,5 +348,20 @@ mod tests {
         assert!(files.contains(&d.join("m.mtl")));
         assert!(files.contains(&d.join("wood.png")));
         std::fs::remove_dir_all(&d).unwrap();
+    }
+
+    /// Percent escapes decode to bytes; a '%' before non-hex or non-ASCII text stays as it is,
+    /// whatever characters follow (no panic on a character cut in the middle).
+    #[test]
+    fn percent_decoding_survives_any_text() {
+        assert_eq!(percent_decode("a%20b.png"), "a b.png");
+        assert_eq!(percent_decode("%C3%A9.png"), "é.png");
+        for uri in [
+            "%1é.png", "%é", "%", "%%", "%2", "é%", "%zz", "%%41", "ü%e9x",
+        ] {
+            let _ = percent_decode(uri);
+        }
+        assert_eq!(percent_decode("%1é.png"), "%1é.png");
+        assert_eq!(percent_decode("%%41"), "%A");
     }
 }

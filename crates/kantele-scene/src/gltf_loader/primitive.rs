@@ -279,6 +279,16 @@ impl Loader<'_> {
                 "{what}: some positions are infinite or NaN; triangles using them are not drawn"
             ));
         }
+        // Strips, fans and loops are unrolled into lists: charge the list first (three
+        // indices per triangle, two per line).
+        let unrolled = match mode {
+            Mode::TriangleStrip | Mode::TriangleFan => vertex_indices.len().saturating_sub(2) * 3,
+            Mode::LineStrip | Mode::LineLoop => vertex_indices.len() * 2,
+            _ => 0,
+        };
+        self.budget
+            .charge(unrolled as u64, 4, &what)
+            .map_err(|e| LoadError::invalid(self.path, e))?;
         let (indices, topology) = match mode {
             Mode::TriangleStrip => (strip_to_list(&vertex_indices), Topology::Triangles),
             Mode::TriangleFan => (fan_to_list(&vertex_indices), Topology::Triangles),

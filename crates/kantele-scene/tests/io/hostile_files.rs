@@ -485,3 +485,45 @@ fn many_material_library_names() {
         "{warnings:?}"
     );
 }
+
+/// A triangle strip or fan of `count` zero indices (an accessor without a buffer view: a few
+/// hundred bytes of file), unrolled by the loader into three indices per triangle.
+fn strip_bomb(mode: u32, count: u64) -> Gltf {
+    let mut g = Gltf::new();
+    let positions = g.vec3(&[[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]);
+    g.json["accessors"]
+        .as_array_mut()
+        .unwrap()
+        .push(json!({"componentType": 5125, "type": "SCALAR", "count": count}));
+    let indices = g.json["accessors"].as_array().unwrap().len() - 1;
+    let mesh = g.mesh(
+        "strip",
+        vec![json!({"attributes": {"POSITION": positions}, "indices": indices, "mode": mode})],
+    );
+    let node = g.node(json!({"mesh": mesh}));
+    g.root(node);
+    g
+}
+
+/// Strips and fans are charged as the lists they become: 2 M indices (8 MB) unroll to 24 MB,
+/// refused under a 20 MB budget that the indices alone fit; a small strip loads.
+#[test]
+fn unrolled_strips_and_fans_are_charged() {
+    let dir = temp_dir("strip-bomb");
+    let options = LoadOptions {
+        max_memory: 20 << 20,
+        ..LoadOptions::default()
+    };
+    for (mode, name) in [(5, "strip"), (6, "fan")] {
+        let path = dir.join(format!("{name}.glb"));
+        strip_bomb(mode, 2_000_000).write_glb(&path);
+        let err = load_scene_with(&path, &options)
+            .expect_err("must be refused")
+            .to_string();
+        assert!(err.contains("memory budget"), "{name}: {err}");
+        let small = dir.join(format!("small-{name}.glb"));
+        strip_bomb(mode, 300).write_glb(&small);
+        let loaded = load_scene_with(&small, &options).expect("a small strip loads");
+        assert_eq!(loaded.scene.meshes[0].indices.len(), 298 * 3, "{name}");
+    }
+}
