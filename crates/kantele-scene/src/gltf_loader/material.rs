@@ -8,7 +8,7 @@ use kantele_rules::scene::{AlphaMode, Material, TextureBinding};
 use kantele_rules::shade::texture::{Filter, MinFilter, Sampler, Texture, Wrap};
 
 use super::spec_gloss::SPEC_GLOSS;
-use super::{named, Loader};
+use super::{capped_name, named, Loader};
 use crate::accessor::BufferData;
 use crate::texture_util::{decode_within, image_size, placeholder, ImageError};
 use crate::uri::read_uri;
@@ -254,7 +254,7 @@ impl<'a> Loader<'a> {
         }
         let finite_or = |v: f32, default: f32| if v.is_finite() { v } else { default };
         let mut out = Material {
-            name: material.name().unwrap_or_default().to_string(),
+            name: capped_name(material.name().unwrap_or_default()),
             base_color_factor: Vec4::from(pbr.base_color_factor()),
             double_sided: material.double_sided(),
             unlit: material.unlit(),

@@ -286,7 +286,19 @@ impl Loader<'_> {
 /// A name for reports: the file's name, or `KIND INDEX`.
 fn named(name: Option<&str>, kind: &str, index: usize) -> String {
     match name {
-        Some(n) if !n.is_empty() => n.to_string(),
+        Some(n) if !n.is_empty() => capped_name(n),
         _ => format!("{kind} {index}"),
+    }
+}
+
+/// The most characters of a name from the file that the scene keeps ([`capped_name`]).
+const MAX_NAME_CHARS: usize = 256;
+
+/// `name` cut to [`MAX_NAME_CHARS`] characters (an ellipsis marks the cut): names are copied
+/// per draw, per warning and per sidecar entry, so a file's name must not be a size it chose.
+fn capped_name(name: &str) -> String {
+    match name.char_indices().nth(MAX_NAME_CHARS) {
+        Some((end, _)) => format!("{}…", &name[..end]),
+        None => name.to_string(),
     }
 }

@@ -4,7 +4,7 @@
 use glam::{Mat4, Quat, Vec3, Vec4};
 use kantele_rules::scene::{Draw, Light, LightKind, NamedCamera, PunctualLight, Shading};
 
-use super::{named, Loader, DEFAULT_RESOLUTION};
+use super::{capped_name, named, Loader, DEFAULT_RESOLUTION};
 use crate::accessor::{read_f32, BufferData};
 use crate::mesh_util::framing_camera;
 use crate::{LoadError, LoadedScene};
@@ -154,7 +154,7 @@ impl Loader<'_> {
                             self.scene.draws.push(Draw {
                                 mesh: mesh_index,
                                 model,
-                                node_name: node.name().unwrap_or_default().to_string(),
+                                node_name: capped_name(node.name().unwrap_or_default()),
                                 node_index: index,
                             });
                             self.rig_draw(self.scene.draws.len() - 1, index, instance, skinned)?;

@@ -527,3 +527,33 @@ fn unrolled_strips_and_fans_are_charged() {
         assert_eq!(loaded.scene.meshes[0].indices.len(), 298 * 3, "{name}");
     }
 }
+
+/// Names from the file are kept to 256 characters (an ellipsis marks the cut): a draw, a
+/// material and a mesh copy their names per draw, warning and sidecar entry, so a 100 000-
+/// character name must not multiply.
+#[test]
+fn long_names_are_cut() {
+    let dir = temp_dir("long-names");
+    let long = "é".repeat(100_000);
+    let mut g = textured_quad();
+    g.json["nodes"][2]["name"] = json!(long);
+    g.json["materials"][0]["name"] = json!(long);
+    g.json["meshes"][0]["name"] = json!(long);
+    let path = dir.join("names.glb");
+    g.write_glb(&path);
+    let loaded = load_scene(&path).expect("loads");
+    let scene = &loaded.scene;
+    let draw = scene
+        .draws
+        .iter()
+        .find(|d| d.node_name.starts_with('é'))
+        .expect("the quad");
+    for name in [
+        &draw.node_name,
+        &scene.materials[0].name,
+        &scene.meshes[0].name,
+    ] {
+        assert_eq!(name.chars().count(), 257, "{}", name.len());
+        assert!(name.ends_with('…'));
+    }
+}
