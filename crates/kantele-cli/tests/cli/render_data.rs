@@ -412,6 +412,35 @@ fn an_mtllib_fifo_does_not_hang() {
     assert!(dir.path("f.png").is_file());
 }
 
+/// `--views` reads only a regular file: a device or a FIFO is refused in one line, without
+/// reading or waiting.
+#[cfg(unix)]
+#[test]
+fn views_from_a_device_or_fifo_are_refused() {
+    let dir = TempDir::new("views-special");
+    let status = Command::new("mkfifo")
+        .arg(dir.path("views.json"))
+        .status()
+        .unwrap();
+    assert!(status.success());
+    for views in ["/dev/zero".to_string(), dir.s("views.json")] {
+        let start = Instant::now();
+        let o = kantele(&[
+            "render",
+            "--builtin",
+            "cube",
+            "--views",
+            &views,
+            "-o",
+            &dir.s("v.png"),
+        ]);
+        let e = err_line(&o);
+        assert!(e.contains("not a regular file"), "{views}: {e}");
+        assert!(start.elapsed() < Duration::from_secs(20), "{views}");
+        assert!(!dir.path("v.png").exists());
+    }
+}
+
 #[cfg(unix)]
 #[test]
 fn interrupt_during_an_orbit_leaves_whole_sets_only() {

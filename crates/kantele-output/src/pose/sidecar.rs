@@ -482,7 +482,38 @@ pub fn read_views(text: &str, defaults: &ViewDefaults) -> Result<Vec<CameraPose>
 
 /// Reads a views file; errors name the file.
 pub fn read_views_file(path: &Path, defaults: &ViewDefaults) -> Result<Vec<CameraPose>, PoseError> {
-    let text =
-        std::fs::read_to_string(path).map_err(|e| err(format!("{}: {e}", path.display())))?;
+    let text = read_views_text(path).map_err(|e| err(format!("{}: {e}", path.display())))?;
     read_views(&text, defaults).map_err(|e| err(format!("{}: {}", path.display(), e.0)))
+}
+
+/// The most bytes a views file may have (a sidecar of a million views takes far less).
+pub const MAX_VIEWS_FILE_BYTES: u64 = 256 << 20;
+
+/// The text of a views file: a regular file (never a device, FIFO or socket, checked on the
+/// opened file too) of at most [`MAX_VIEWS_FILE_BYTES`], in UTF-8.
+fn read_views_text(path: &Path) -> Result<String, String> {
+    use std::io::Read;
+    let not_regular = "not a regular file".to_string();
+    let meta = std::fs::metadata(path).map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err(not_regular);
+    }
+    let too_large =
+        |len: u64| format!("{len} bytes, more than a views file may have ({MAX_VIEWS_FILE_BYTES})");
+    if meta.len() > MAX_VIEWS_FILE_BYTES {
+        return Err(too_large(meta.len()));
+    }
+    let file = std::fs::File::open(path).map_err(|e| e.to_string())?;
+    let meta = file.metadata().map_err(|e| e.to_string())?;
+    if !meta.is_file() {
+        return Err(not_regular);
+    }
+    if meta.len() > MAX_VIEWS_FILE_BYTES {
+        return Err(too_large(meta.len()));
+    }
+    let mut text = String::new();
+    file.take(MAX_VIEWS_FILE_BYTES)
+        .read_to_string(&mut text)
+        .map_err(|e| e.to_string())?;
+    Ok(text)
 }
