@@ -1,16 +1,21 @@
 //! Triangulating polygons (OBJ and PLY faces with more than three corners) by ear clipping, so
 //! that concave faces keep their shape (a fan would cover area outside them).
+//!
+//! The ears are found by `earcut` (Mapbox's earcut, maintained by georust): ear clipping with
+//! a z-order index of the corners, so a polygon of thousands of corners (a hostile comb of
+//! 4 094 took seconds with plain ear clipping, a file of them minutes) is cut in about
+//! `n log n`. Self-intersecting polygons are cut as earcut cuts them.
 
 use glam::{Vec2, Vec3};
 
 use crate::budget::Budget;
 
-/// Polygons with more corners than this are fan-split instead (ear clipping is quadratic).
+/// Polygons with more corners than this are fan-split instead.
 pub(crate) const MAX_EAR_CLIP_CORNERS: usize = 4096;
 
-/// Triangles (as corner numbers `0..n`, counter-clockwise like the polygon) covering the
-/// polygon with the given corner positions; `None` when it is too large or degenerate for ear
-/// clipping (the caller falls back to a fan).
+/// Triangles (as corner numbers `0..n`, with the polygon's winding) covering the polygon with
+/// the given corner positions; `None` when it is too large or degenerate for ear clipping (the
+/// caller falls back to a fan).
 pub(crate) fn triangulate(corners: &[Vec3]) -> Option<Vec<[usize; 3]>> {
     let n = corners.len();
     if !(3..=MAX_EAR_CLIP_CORNERS).contains(&n) || corners.iter().any(|c| !c.is_finite()) {
@@ -36,60 +41,28 @@ pub(crate) fn triangulate(corners: &[Vec3]) -> Option<Vec<[usize; 3]>> {
         .iter()
         .map(|c| Vec2::new(c.dot(u), c.dot(v)))
         .collect();
-    // With this basis the polygon is counter-clockwise in (u, v).
-    let cross = |a: Vec2, b: Vec2, c: Vec2| (b - a).perp_dot(c - a);
-    let mut remaining: Vec<usize> = (0..n).collect();
-    let mut triangles = Vec::with_capacity(n - 2);
-    let mut guard = 0;
-    while remaining.len() > 3 {
-        let m = remaining.len();
-        let mut clipped = false;
-        for i in 0..m {
-            let (ia, ib, ic) = (
-                remaining[(i + m - 1) % m],
-                remaining[i],
-                remaining[(i + 1) % m],
-            );
-            let (a, b, c) = (p[ia], p[ib], p[ic]);
-            if cross(a, b, c) <= 0.0 {
-                continue; // reflex or flat corner
-            }
-            let inside = remaining.iter().any(|&j| {
-                if j == ia || j == ib || j == ic {
-                    return false;
-                }
-                let q = p[j];
-                cross(a, b, q) >= 0.0 && cross(b, c, q) >= 0.0 && cross(c, a, q) >= 0.0
-            });
-            if !inside {
-                triangles.push([ia, ib, ic]);
-                remaining.remove(i);
-                clipped = true;
-                break;
-            }
-        }
-        if !clipped {
-            guard += 1;
-            if guard > 1 {
-                return None; // self-intersecting or degenerate: no ear left
-            }
-            // Drop a flat corner (collinear neighbours) and try again.
-            let m = remaining.len();
-            let flat = (0..m).find(|&i| {
-                let (a, b, c) = (
-                    p[remaining[(i + m - 1) % m]],
-                    p[remaining[i]],
-                    p[remaining[(i + 1) % m]],
-                );
-                cross(a, b, c).abs() <= f32::EPSILON * (b - a).length() * (c - b).length()
-            })?;
-            remaining.remove(flat);
-        } else {
-            guard = 0;
-        }
+    // With this basis the polygon is counter-clockwise in (u, v): triangles turning the other
+    // way are reversed, so each keeps the polygon's winding in space.
+    let flat: Vec<[f64; 2]> = p.iter().map(|q| [q.x as f64, q.y as f64]).collect();
+    let mut indices: Vec<u32> = Vec::with_capacity(3 * (n - 2));
+    earcut::Earcut::new().earcut_slice(&flat, &[], &mut indices);
+    if indices.is_empty() {
+        return None;
     }
-    triangles.push([remaining[0], remaining[1], remaining[2]]);
-    Some(triangles)
+    let cross = |a: Vec2, b: Vec2, c: Vec2| (b - a).perp_dot(c - a);
+    Some(
+        indices
+            .chunks_exact(3)
+            .map(|t| {
+                let [a, b, c] = [t[0] as usize, t[1] as usize, t[2] as usize];
+                if cross(p[a], p[b], p[c]) < 0.0 {
+                    [a, c, b]
+                } else {
+                    [a, b, c]
+                }
+            })
+            .collect(),
+    )
 }
 
 /// Triangles of the faces (`arities` corners each; empty means all triangles): polygons by ear
@@ -177,6 +150,39 @@ mod tests {
         let sq = [Vec3::ZERO, Vec3::Y, Vec3::new(1.0, 1.0, 0.0), Vec3::X];
         let tris = triangulate(&sq).unwrap();
         assert!((area(&sq, &tris) + 1.0).abs() < 1e-5);
+    }
+
+    /// A comb of 4 094 corners (1 023 teeth), the shape that made plain ear clipping cubic:
+    /// cut into 4 092 triangles of the comb's area and winding.
+    #[test]
+    fn a_comb_keeps_its_area() {
+        let teeth = 1023;
+        let mut comb = Vec::new();
+        for i in 0..teeth {
+            let x = 2.0 * i as f32;
+            comb.extend([
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x + 1.0, 0.0, 0.0),
+                Vec3::new(x + 1.0, 10.0, 0.0),
+                Vec3::new(x + 2.0, 10.0, 0.0),
+            ]);
+        }
+        let end = 2.0 * teeth as f32;
+        comb.extend([Vec3::new(end, -1.0, 0.0), Vec3::new(0.0, -1.0, 0.0)]);
+        // Built clockwise; turned counter-clockwise.
+        comb.reverse();
+        assert_eq!(comb.len(), 4094);
+        // Each tooth's area 10 (its 1 × 10 column), over a 1-high base; plus the last column
+        // from x = end − 1 up to 10.
+        let tris = triangulate(&comb).expect("triangulated");
+        assert_eq!(tris.len(), comb.len() - 2);
+        let want = end + 10.0 * teeth as f32;
+        assert!(
+            (area(&comb, &tris) - want).abs() < 1e-2 * want,
+            "{}",
+            area(&comb, &tris)
+        );
+        assert!(tris.iter().all(|t| area(&comb, &[*t]) >= 0.0));
     }
 
     #[test]
