@@ -209,8 +209,10 @@ pub fn load(path: &Path, options: &LoadOptions) -> Result<LoadedScene, LoadError
                 .map_err(|e| LoadError::invalid(path, e))?;
             flat_normals(&mut mesh);
         }
-        if scene.materials[mesh.material].normal_texture.is_some() {
-            // MikkTSpace tangents for the normal map (the MTL's maps read the one set).
+        let pbr = options.shading == Some(kantele_rules::scene::Shading::Pbr);
+        if pbr && scene.materials[mesh.material].normal_texture.is_some() {
+            // MikkTSpace tangents for the normal map (the MTL's maps read the one set); only
+            // PBR shading reads them.
             crate::tangents::generate(&mut mesh, 0, &mut budget, &what)
                 .map_err(|e| LoadError::invalid(path, e))?;
         }

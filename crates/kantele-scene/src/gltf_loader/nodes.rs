@@ -268,11 +268,7 @@ impl Loader<'_> {
     /// Decides the shading model (see [`crate::LoadOptions::shading`]) and sets up what goes
     /// with it ([`crate::shading::apply`]).
     fn choose_shading(&mut self) -> Result<(), LoadError> {
-        let default = if self.reference_extras {
-            Shading::Lambert
-        } else {
-            Shading::Pbr
-        };
+        let default = self.default_shading();
         crate::shading::apply(
             &mut self.scene,
             &mut self.info,
@@ -282,6 +278,21 @@ impl Loader<'_> {
             &mut self.budget,
         )
         .map_err(|e| self.invalid(e))
+    }
+
+    /// The shading the file gets without `--shading`: Lambert for a reference scene (its
+    /// extras carry `ambient`, read by [`Self::extras`]), PBR for every other.
+    fn default_shading(&self) -> Shading {
+        if self.reference_extras {
+            Shading::Lambert
+        } else {
+            Shading::Pbr
+        }
+    }
+
+    /// The shading the scene is drawn with (known once the scene's extras are read).
+    pub(super) fn shading(&self) -> Shading {
+        self.options.shading.unwrap_or(self.default_shading())
     }
 
     /// Reads `resolution`, `clear_color` and `ambient` from the scene's extras.

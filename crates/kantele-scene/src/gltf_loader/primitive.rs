@@ -3,7 +3,7 @@
 use glam::{Vec2, Vec3, Vec4};
 use gltf::accessor::{DataType, Dimensions};
 use gltf::mesh::{Mode, Semantic};
-use kantele_rules::scene::{Mesh, Topology};
+use kantele_rules::scene::{Mesh, Shading, Topology};
 
 use super::material::UvMap;
 use super::{morph, named, Loader};
@@ -30,7 +30,9 @@ impl Loader<'_> {
                 .map_err(|e| self.invalid(e))?;
             flat_normals(&mut converted);
         }
-        if converted.tangents.is_none() {
+        // Tangents only serve PBR shading (MikkTSpace takes about 1.5 s per million
+        // triangles).
+        if converted.tangents.is_none() && self.shading() == Shading::Pbr {
             if let Some(set) = self.normal_map_of(converted.material) {
                 tangents::generate(&mut converted, set, &mut self.budget, &what)
                     .map_err(|e| self.invalid(e))?;

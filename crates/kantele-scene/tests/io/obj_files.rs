@@ -609,7 +609,8 @@ fn vertex_colours_are_decoded_from_srgb() {
     }
 }
 
-/// A material with a normal map (`norm`) gives its meshes MikkTSpace tangents.
+/// A material with a normal map (`norm`) gives its meshes MikkTSpace tangents when the file is
+/// drawn with PBR shading (OBJ's default, Lambert, reads none).
 #[test]
 fn normal_mapped_materials_get_tangents() {
     let dir = write_files(
@@ -623,7 +624,13 @@ fn normal_mapped_materials_get_tangents() {
         ],
     );
     std::fs::write(dir.join("bumps.png"), test_png()).expect("write");
-    let loaded = load_scene(&dir.join("n.obj")).expect("loads");
+    let lambert = load_scene(&dir.join("n.obj")).expect("loads");
+    assert!(lambert.scene.meshes[0].tangents.is_none());
+    let pbr = kantele_scene::LoadOptions {
+        shading: Some(kantele::scene::Shading::Pbr),
+        ..Default::default()
+    };
+    let loaded = kantele_scene::load_scene_with(&dir.join("n.obj"), &pbr).expect("loads");
     let mesh = &loaded.scene.meshes[0];
     let tangents = mesh.tangents.as_ref().expect("tangents");
     assert_eq!(tangents.len(), mesh.positions.len());

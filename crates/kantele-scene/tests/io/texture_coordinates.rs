@@ -5,7 +5,8 @@
 
 use crate::common::*;
 use glam::{Vec2, Vec4};
-use kantele_scene::{load_scene, LoadedScene};
+use kantele::scene::Shading;
+use kantele_scene::{load_scene, load_scene_with, LoadOptions, LoadedScene};
 use serde_json::{json, Value};
 
 /// The common textured quad with `material` on its primitive and `extra` attributes.
@@ -24,7 +25,8 @@ fn load(g: &Gltf, name: &str) -> LoadedScene {
 }
 
 /// A normal texture without the file's tangents: MikkTSpace gives the quad (u along +x, v along
-/// −y) the tangent +x with w = +1, so the bitangent n × t = +y points up the image.
+/// −y) the tangent +x with w = +1, so the bitangent n × t = +y points up the image. Only PBR
+/// shading reads tangents: the quad drawn as a (Lambert) reference scene gets none.
 #[test]
 fn a_normal_texture_without_tangents_gets_mikktspace_tangents() {
     let mut g = textured_quad();
@@ -33,7 +35,15 @@ fn a_normal_texture_without_tangents_gets_mikktspace_tangents() {
         &[],
         &mut g,
     );
-    let loaded = load(&g, "generated");
+    let path = temp_dir("texture-coordinates").join("generated.glb");
+    g.write_glb(&path);
+    let lambert = load_scene(&path).expect("loads");
+    assert!(lambert.scene.meshes[0].tangents.is_none());
+    let pbr = LoadOptions {
+        shading: Some(Shading::Pbr),
+        ..LoadOptions::default()
+    };
+    let loaded = load_scene_with(&path, &pbr).expect("loads");
     let mesh = &loaded.scene.meshes[0];
     let tangents = mesh.tangents.as_ref().expect("tangents");
     assert_eq!(tangents.len(), mesh.positions.len());
