@@ -700,11 +700,18 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((w as u32, h as u32))
 }
 
-/// Parses a vertical field of view in degrees, in (0, 180).
+/// The narrowest field of view `--fov` takes, in degrees: a camera framing the scene through
+/// a narrower one stands so far away (over 10 000 times the scene's radius) that 32-bit
+/// positions no longer tell its triangles apart, and the picture comes out empty.
+pub const MIN_FOV_DEG: f32 = 0.01;
+
+/// Parses a vertical field of view in degrees, in [[`MIN_FOV_DEG`], 180).
 pub fn parse_fov(s: &str) -> Result<f32, String> {
     match s.trim().parse::<f32>() {
-        Ok(v) if v > 0.0 && v < 180.0 => Ok(v),
-        _ => Err(format!("field of view '{s}' must be degrees in (0, 180)")),
+        Ok(v) if (MIN_FOV_DEG..180.0).contains(&v) => Ok(v),
+        _ => Err(format!(
+            "field of view '{s}' must be degrees in [{MIN_FOV_DEG}, 180)"
+        )),
     }
 }
 

@@ -72,6 +72,42 @@ fn bad_sizes() {
     }
 }
 
+/// A field of view outside [0.01°, 180°) is refused in one line: a narrower one frames the
+/// scene from so far away that the picture came out empty, silently.
+#[test]
+fn bad_fields_of_view() {
+    let dir = TempDir::new("fov");
+    for fov in ["0", "1e-30", "0.009", "180", "nan", "inf"] {
+        let o = kantele(&[
+            "render",
+            "--builtin",
+            "cube",
+            "-o",
+            &dir.s("out.png"),
+            "--fov",
+            fov,
+        ]);
+        assert_clean_failure(&o, "field of view", &dir, &[]);
+    }
+    let o = kantele(&[
+        "render",
+        "--builtin",
+        "cube",
+        "--size",
+        "32x32",
+        "-o",
+        &dir.s("narrow.png"),
+        "--fov",
+        "0.01",
+    ]);
+    assert!(o.status.success(), "{}", crate::common::stderr(&o));
+    let picture = image::open(dir.path("narrow.png")).unwrap().to_rgba8();
+    assert!(
+        picture.pixels().any(|p| p.0 != picture.get_pixel(0, 0).0),
+        "the cube is drawn at the narrowest field of view"
+    );
+}
+
 #[test]
 fn unknown_strategy() {
     let dir = TempDir::new("strategy");
