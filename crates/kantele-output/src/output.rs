@@ -5,6 +5,12 @@
 //! All buffers are row-major with row 0 at the top of the image (PFM stores rows bottom-up in
 //! the file, as its format requires; the writer does that). Nothing here knows the CLI: the
 //! Python package calls the same functions.
+//!
+//! Temporaries are named `.NAME.tmp-PID-N` next to the file they become. A process killed
+//! before it could remove its own leaves them behind: the next write to that file removes
+//! those whose process no longer runs. An [`OutputSet`] moves its files into place holding an
+//! exclusive lock on each of their folders, so two processes writing the same outputs at once
+//! leave one's whole set, never a mix of both.
 
 use std::fs::File;
 use std::io::{self, BufWriter, Seek, Write};
@@ -36,22 +42,84 @@ pub type FileWriter = BufWriter<File>;
 
 static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
-/// A temporary name next to `path` (same folder, so a rename moves it into place), unique per
-/// process and call.
-fn temp_path(path: &Path) -> Result<PathBuf, OutputError> {
-    let dir = match path.parent() {
+/// The folder `path` is in (`.` for a bare name).
+fn folder_of(path: &Path) -> PathBuf {
+    match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
-    };
+    }
+}
+
+/// A temporary name next to `path` (same folder, so a rename moves it into place), unique per
+/// process and call. Stale temporaries of `path` are removed first
+/// ([`remove_stale_temporaries`]).
+fn temp_path(path: &Path) -> Result<PathBuf, OutputError> {
+    let dir = folder_of(path);
     let name = path
         .file_name()
         .ok_or_else(|| output_error(path, "not a file name"))?;
+    remove_stale_temporaries(&dir, &name.to_string_lossy());
     let n = TEMP_COUNTER.fetch_add(1, Ordering::Relaxed);
     Ok(dir.join(format!(
         ".{}.tmp-{}-{n}",
         name.to_string_lossy(),
         std::process::id()
     )))
+}
+
+/// Removes from `dir` the temporaries of the file `name` (`.NAME.tmp-PID-N`) whose process no
+/// longer runs: what a killed writer left. A temporary of a running process (this one, or
+/// another writing the same file now) stays; where processes cannot be looked up (outside
+/// Linux), every one stays.
+fn remove_stale_temporaries(dir: &Path, name: &str) {
+    let prefix = format!(".{name}.tmp-");
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for entry in entries.flatten() {
+        let file_name = entry.file_name();
+        let Some(rest) = file_name.to_str().and_then(|f| f.strip_prefix(&prefix)) else {
+            continue;
+        };
+        let Some((pid, counter)) = rest.split_once('-') else {
+            continue;
+        };
+        let (Ok(pid), true) = (
+            pid.parse::<u32>(),
+            !counter.is_empty() && counter.bytes().all(|b| b.is_ascii_digit()),
+        ) else {
+            continue;
+        };
+        if process_ended(pid) {
+            let _ = std::fs::remove_file(entry.path());
+        }
+    }
+}
+
+/// Whether process `pid` is known to have ended (`false` where that cannot be told).
+fn process_ended(pid: u32) -> bool {
+    if cfg!(target_os = "linux") {
+        pid != std::process::id() && !Path::new("/proc").join(pid.to_string()).exists()
+    } else {
+        false
+    }
+}
+
+/// Exclusive locks on the folders of `paths` (each once, in sorted order, so two sets never
+/// wait on each other), held until dropped. A folder that cannot be locked is skipped: the
+/// lock orders writers, it is not needed to write.
+fn lock_folders<'a>(paths: impl Iterator<Item = &'a Path>) -> Vec<File> {
+    let mut folders: Vec<PathBuf> = paths.map(folder_of).collect();
+    folders.sort();
+    folders.dedup();
+    folders
+        .into_iter()
+        .filter_map(|dir| {
+            let handle = File::open(&dir).ok()?;
+            handle.lock().ok()?;
+            Some(handle)
+        })
+        .collect()
 }
 
 /// Writes `path`'s content into a new temporary file; removes it on failure.
@@ -152,6 +220,8 @@ impl OutputSet {
     /// the error names the file.
     pub fn commit(mut self) -> Result<(), OutputError> {
         let pending = std::mem::take(&mut self.pending);
+        // Released when dropped, after every move.
+        let _locks = lock_folders(pending.iter().map(|(_, path)| path.as_path()));
         let mut iter = pending.into_iter();
         for (tmp, path) in iter.by_ref() {
             if let Err(e) = std::fs::rename(&tmp, &path) {
@@ -742,5 +812,73 @@ mod tests {
             .unwrap();
         assert!(set.commit().unwrap_err().to_string().contains("blocked"));
         assert_eq!(dir.files(), vec!["a.pfm", "a.png", "a.png.json", "blocked"]);
+    }
+
+    /// A later write to a file removes the temporaries a killed writer of that file left (its
+    /// process is gone), and nothing else: not those of a running process, not other names.
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn stale_temporaries_of_ended_processes_are_removed() {
+        let dir = TempDir::new("stale");
+        let out = dir.0.join("a.png");
+        // No process has this id (above Linux's largest pid_max).
+        let stale = ".a.png.tmp-999999999-0";
+        let running = format!(".a.png.tmp-{}-77", std::process::id());
+        let keep = [
+            ".a.png.tmp-x",
+            ".b.png.tmp-999999999-0",
+            "a.png.tmp-999999999-0",
+        ];
+        for name in [stale, running.as_str()].into_iter().chain(keep) {
+            std::fs::write(dir.0.join(name), b"old").unwrap();
+        }
+        write_atomic(&out, |w| w.write_all(b"new")).unwrap();
+        let files = dir.files();
+        assert!(!files.contains(&stale.to_string()), "{files:?}");
+        assert!(files.contains(&running), "{files:?}");
+        for name in keep {
+            assert!(files.contains(&name.to_string()), "{name}: {files:?}");
+        }
+        assert_eq!(std::fs::read(&out).unwrap(), b"new");
+    }
+
+    /// Two writers committing sets of the same two files, over and over: whenever the folder
+    /// is quiet (its lock held by the reader), both files come from the same set.
+    #[cfg(unix)]
+    #[test]
+    fn concurrent_sets_never_mix() {
+        let dir = TempDir::new("concurrent");
+        let (a, b) = (dir.0.join("a.txt"), dir.0.join("b.txt"));
+        let stop = std::sync::atomic::AtomicBool::new(false);
+        let mut mixed = 0;
+        std::thread::scope(|scope| {
+            for writer in ["first", "second"] {
+                let (a, b, stop) = (&a, &b, &stop);
+                scope.spawn(move || {
+                    let mut round = 0;
+                    while !stop.load(Ordering::Relaxed) {
+                        let text = format!("{writer} {round}");
+                        let mut set = OutputSet::new();
+                        set.write(a, |w| w.write_all(text.as_bytes())).unwrap();
+                        set.write(b, |w| w.write_all(text.as_bytes())).unwrap();
+                        set.commit().unwrap();
+                        round += 1;
+                    }
+                });
+            }
+            let mut checked = 0;
+            while checked < 300 {
+                let folder = File::open(&dir.0).unwrap();
+                folder.lock().unwrap();
+                if let (Ok(x), Ok(y)) = (std::fs::read(&a), std::fs::read(&b)) {
+                    mixed += usize::from(x != y);
+                    checked += 1;
+                }
+                drop(folder);
+                std::thread::yield_now();
+            }
+            stop.store(true, Ordering::Relaxed);
+        });
+        assert_eq!(mixed, 0, "sets mixed");
     }
 }
