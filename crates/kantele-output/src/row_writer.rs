@@ -263,7 +263,7 @@ impl<W: Write + Seek + 'static> RowWriter<W> {
         }
         let per_row = self.width as usize * self.channels;
         let count = rows.len() / per_row;
-        if rows.len() % per_row != 0 || count > (self.height - self.next_row) as usize {
+        if !rows.len().is_multiple_of(per_row) || count > (self.height - self.next_row) as usize {
             return Err(invalid(format!(
                 "{} values are not whole rows of a {}x{} image with {} rows left",
                 rows.len(),

@@ -75,7 +75,7 @@ pub(crate) fn triangulate_faces(
     budget: &mut Budget,
 ) -> Result<Vec<u32>, String> {
     if arities.is_empty() {
-        if indices.len() % 3 != 0 {
+        if !indices.len().is_multiple_of(3) {
             return Err("the faces do not make whole triangles".to_string());
         }
         return Ok(indices.to_vec());

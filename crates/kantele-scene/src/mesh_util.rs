@@ -16,7 +16,7 @@ pub const FRAMING_DIRECTION: Vec3 = Vec3::new(0.4, 0.5, 1.0);
 /// unchanged and [`Scene::validate`] reports the problem.
 pub fn flat_normals(mesh: &mut Mesh) {
     let n = mesh.positions.len();
-    if mesh.indices.len() % 3 != 0 || mesh.indices.iter().any(|&i| i as usize >= n) {
+    if !mesh.indices.len().is_multiple_of(3) || mesh.indices.iter().any(|&i| i as usize >= n) {
         return;
     }
     let attribute_ok = |len: Option<usize>| len.is_none_or(|l| l == n);

@@ -50,7 +50,7 @@ pub(crate) fn generate(
     if mesh.topology != Topology::Triangles
         || normals.len() != n
         || texcoords.len() != n
-        || mesh.indices.len() % 3 != 0
+        || !mesh.indices.len().is_multiple_of(3)
         || mesh.indices.iter().any(|&i| i as usize >= n)
     {
         return Ok(());

@@ -136,7 +136,7 @@ pub fn checker(size: u32, squares: u32, a: [u8; 3], b: [u8; 3]) -> Texture {
     let mut rgba = Vec::with_capacity(size as usize * size as usize * 4);
     for y in 0..size {
         for x in 0..size {
-            let c = if ((x / cell) + (y / cell)) % 2 == 0 {
+            let c = if ((x / cell) + (y / cell)).is_multiple_of(2) {
                 a
             } else {
                 b

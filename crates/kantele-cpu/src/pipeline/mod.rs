@@ -343,10 +343,12 @@ impl<'a> Frame<'_, 'a> {
         }
         let count = indices.len(vertices.len());
         match topology {
-            Topology::Triangles if count % 3 != 0 => {
+            Topology::Triangles if !count.is_multiple_of(3) => {
                 return Err(RenderError::IncompleteTriangle(count))
             }
-            Topology::Lines if count % 2 != 0 => return Err(RenderError::IncompleteLine(count)),
+            Topology::Lines if !count.is_multiple_of(2) => {
+                return Err(RenderError::IncompleteLine(count))
+            }
             _ => {}
         }
         let out_of_range = |ix: usize| ix >= vertices.len();

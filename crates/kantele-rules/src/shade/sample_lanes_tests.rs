@@ -131,7 +131,7 @@ fn queries(rng: &mut Rng, count: usize) -> Vec<Query> {
             }
             // Half the rows share one footprint (one level for all lanes, as in a typical
             // row of pixels), half have one per lane.
-            if rng.next() % 2 == 0 {
+            if rng.next().is_multiple_of(2) {
                 duv_dx = [duv_dx[0]; 8];
                 duv_dy = [duv_dy[0]; 8];
             }

@@ -304,7 +304,7 @@ impl Loader<'_> {
                     Topology::Triangles
                 };
                 let per = topology.vertices_per_primitive();
-                if vertex_indices.len() % per != 0 {
+                if !vertex_indices.len().is_multiple_of(per) {
                     return Err(self.invalid(format!(
                         "{what}: {} indices do not make whole {}",
                         vertex_indices.len(),

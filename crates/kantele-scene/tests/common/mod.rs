@@ -136,7 +136,7 @@ impl Gltf {
 
     /// Appends raw bytes as a buffer view (4-byte aligned); returns its index.
     pub fn view(&mut self, bytes: &[u8]) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let offset = self.bin.len();
@@ -269,11 +269,11 @@ impl Gltf {
             this.json["images"][i]["bufferView"] = json!(view);
             this.json["images"][i]["mimeType"] = json!("image/png");
         }
-        while this.bin.len() % 4 != 0 {
+        while !this.bin.len().is_multiple_of(4) {
             this.bin.push(0);
         }
         let mut json = serde_json::to_vec(&this.finished_json(None)).expect("json");
-        while json.len() % 4 != 0 {
+        while !json.len().is_multiple_of(4) {
             json.push(b' ');
         }
         let total = 12 + 8 + json.len() + 8 + this.bin.len();

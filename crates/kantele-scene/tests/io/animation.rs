@@ -23,7 +23,7 @@ struct Doc {
 impl Doc {
     /// Appends an accessor over new bytes; returns its index.
     fn accessor(&mut self, bytes: &[u8], component: u32, ty: &str, count: usize) -> usize {
-        while self.bin.len() % 4 != 0 {
+        while !self.bin.len().is_multiple_of(4) {
             self.bin.push(0);
         }
         let views = self.json["bufferViews"].as_array_mut().unwrap();

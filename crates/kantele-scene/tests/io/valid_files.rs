@@ -254,7 +254,7 @@ fn meshopt_compressed_views_decode() {
         json!({"byteLength": 1024, "extensions": {"EXT_meshopt_compression": {"fallback": true}}}),
     );
     let mut text = serde_json::to_vec(&doc).unwrap();
-    while text.len() % 4 != 0 {
+    while !text.len().is_multiple_of(4) {
         text.push(b' ');
     }
     let bin = &bytes[20 + json_len..];
