@@ -5,9 +5,10 @@
 //! Devices, FIFOs, sockets and folders are never read, and a file larger than the memory budget
 //! allows is refused before it is read.
 //!
-//! The check holds for the file actually opened: after opening, the path is resolved again and
-//! must still lie inside and name the very file opened (device and inode), so a folder swapped
-//! for a symbolic link between the check and the open is refused. A path outside the allowed
+//! The check holds for the file actually opened: after opening, the open file's own path (on
+//! Linux, as the kernel gives it; elsewhere, the path resolved again, which must name the very
+//! file opened) must still lie inside, so a folder swapped for a symbolic link between the
+//! check and the open is refused. A path outside the allowed
 //! folders gets the same error whether or not a file is there (no existence oracle).
 //!
 //! Every file a load reads is recorded ([`record_reads`]): the command compares its outputs with
@@ -72,9 +73,19 @@ impl ReadPolicy {
         self.roots.iter().any(|root| path.starts_with(root))
     }
 
-    /// Whether `file`, resolved again now that `opened` is open, lies inside and is that very
-    /// file (same device and inode): not a path whose folders were swapped in between.
+    /// Whether the file `opened` lies inside: on Linux, the path the kernel gives for the open
+    /// file (`/proc/self/fd/N`, which no later swap can change); elsewhere, `file` resolved
+    /// again must lie inside and be that very file (same device and inode): not a path whose
+    /// folders were swapped in between.
     fn still_inside(&self, file: &Path, opened: &std::fs::File) -> bool {
+        #[cfg(target_os = "linux")]
+        {
+            use std::os::fd::AsRawFd;
+            let link = format!("/proc/self/fd/{}", opened.as_raw_fd());
+            if let Ok(actual) = std::fs::read_link(link) {
+                return self.inside(&actual);
+            }
+        }
         let Ok(now) = std::fs::canonicalize(file) else {
             return false;
         };
