@@ -9,6 +9,11 @@ use crate::accessor::{read_f32, BufferData};
 use crate::mesh_util::framing_camera;
 use crate::{LoadError, LoadedScene};
 
+/// The smallest near plane a perspective file camera keeps, as a fraction of the distance to
+/// the far side of the scene ([`Loader::raise_near_planes`]): depths there still differ from
+/// the far plane's by about 30 steps of 32-bit float.
+const MIN_NEAR_FRACTION: f32 = 1e-6;
+
 impl Loader<'_> {
     pub(super) fn run(mut self) -> Result<LoadedScene, LoadError> {
         let document = self.document;
@@ -170,6 +175,7 @@ impl Loader<'_> {
 
         self.scene.light = light.unwrap_or(Light::Headlight);
         let animation = self.finish_rig()?;
+        self.raise_near_planes();
         // The first file camera, as posed.
         let camera = camera.and(self.scene.file_cameras.first().map(|c| c.camera));
         self.choose_shading()?;
@@ -191,6 +197,33 @@ impl Loader<'_> {
             info: self.info,
             animation,
         })
+    }
+
+    /// Raises, with a warning, the near plane of each perspective file camera that is so close
+    /// that 32-bit depth cannot tell the scene from the far plane: depth `1 − 2 znear / d` rounds
+    /// to 1 once `d / znear` passes about 2²⁴, and the scene then counts as outside the view
+    /// volume (an empty picture, without the empty-picture warning). The near plane becomes at
+    /// least [`MIN_NEAR_FRACTION`] of the distance from the camera to the far side of the scene.
+    fn raise_near_planes(&mut self) {
+        let Some((center, radius)) = self.scene.bounding_sphere() else {
+            return;
+        };
+        for named in &mut self.scene.file_cameras {
+            let camera = &mut named.camera;
+            if camera.ymag.is_some() {
+                continue;
+            }
+            let eye = camera.view.inverse().transform_point3(Vec3::ZERO);
+            let reach = (eye - center).length() + radius;
+            let least = reach * MIN_NEAR_FRACTION;
+            if reach.is_finite() && camera.znear < least {
+                self.info.warn(format!(
+                    "camera '{}': its near plane ({:e}) is too close for the depth buffer over a scene {reach:.3e} away; raised to {least:.3e}",
+                    named.name, camera.znear
+                ));
+                camera.znear = least;
+            }
+        }
     }
 
     /// The instance transforms of `EXT_mesh_gpu_instancing` a node's mesh is drawn with (each
