@@ -464,38 +464,9 @@ pub(crate) fn color_space_note(bytes: &[u8], color_space: ColorSpace) -> Option<
     })
 }
 
-/// Body of the `dds` fuzz target: reads the size and decodes the bytes under a 64 MiB budget.
-/// An error is a valid outcome when it is one line; a panic in Kantele's own code (also one
-/// that [`caught`] turned into an error), a decoded size other than the header's, or an error
-/// of several lines is a defect (a panic).
+/// Body of the `dds` fuzz target ([`crate::texture_util::fuzz_image_decoder`]).
 pub(crate) fn fuzz(data: &[u8]) {
-    let check = |error: &ImageError| {
-        let (ImageError::Budget(message) | ImageError::Decode(message)) = error;
-        assert!(
-            !message.contains('\n'),
-            "an error of several lines: {message}"
-        );
-        if message.starts_with("malformed DDS file") {
-            let file = crate::quiet_panic::last_caught_file().unwrap_or_default();
-            let file = file.replace('\\', "/");
-            assert!(
-                file.contains("/.cargo/") || file.contains("/rustc/") || !file.contains("kantele"),
-                "Kantele's own code panicked in {file}: {message}"
-            );
-        }
-    };
-    let size = dds_size(data);
-    if let Err(e) = &size {
-        check(e);
-    }
-    let mut budget = Budget::new(64 << 20);
-    match decode_dds(data, ColorSpace::Srgb, &mut budget) {
-        Ok(texture) => {
-            let size = size.unwrap_or_else(|e| panic!("decoded, but no size: {e:?}"));
-            assert_eq!((texture.width(), texture.height()), size);
-        }
-        Err(e) => check(&e),
-    }
+    crate::texture_util::fuzz_image_decoder(data, "malformed DDS file", dds_size, decode_dds);
 }
 
 #[cfg(test)]

@@ -170,3 +170,43 @@ mod tests {
         assert!(decode_srgb(b"\x89PNG\r\n\x1a\n broken", Some("image/png")).is_err());
     }
 }
+
+/// Body of the fuzz targets of an image decoder (`ktx2`, `dds`): reads the size with `size`
+/// and decodes the bytes with `decode` under a 64 MiB budget. An error is a valid outcome when
+/// it is one line; a panic in Kantele's own code (also one caught and turned into an error
+/// starting with `malformed`), a decoded size other than the header's, or an error of several
+/// lines is a defect (a panic).
+pub(crate) fn fuzz_image_decoder(
+    data: &[u8],
+    malformed: &str,
+    size: fn(&[u8]) -> Result<(u32, u32), ImageError>,
+    decode: fn(&[u8], ColorSpace, &mut Budget) -> Result<Texture, ImageError>,
+) {
+    let check = |error: &ImageError| {
+        let (ImageError::Budget(message) | ImageError::Decode(message)) = error;
+        assert!(
+            !message.contains('\n'),
+            "an error of several lines: {message}"
+        );
+        if message.starts_with(malformed) {
+            let file = crate::quiet_panic::last_caught_file().unwrap_or_default();
+            let file = file.replace('\\', "/");
+            assert!(
+                file.contains("/.cargo/") || file.contains("/rustc/") || !file.contains("kantele"),
+                "Kantele's own code panicked in {file}: {message}"
+            );
+        }
+    };
+    let declared = size(data);
+    if let Err(e) = &declared {
+        check(e);
+    }
+    let mut budget = Budget::new(64 << 20);
+    match decode(data, ColorSpace::Srgb, &mut budget) {
+        Ok(texture) => {
+            let declared = declared.unwrap_or_else(|e| panic!("decoded, but no size: {e:?}"));
+            assert_eq!((texture.width(), texture.height()), declared);
+        }
+        Err(e) => check(&e),
+    }
+}
