@@ -54,12 +54,17 @@ struct VaryingLayout {
     tangent: Option<usize>,
     /// The vertex colour (four), where the mesh has colours.
     color: Option<usize>,
+    /// The texture coordinates (two) whose derivatives orient the tangent frame of a draw that
+    /// bends normals without mesh tangents (0 where none: never read).
+    frame_texcoord: usize,
     /// Varyings in all.
     count: usize,
 }
 
 impl VaryingLayout {
-    fn new(texcoords: [bool; 2], tangent: bool, color: bool) -> Self {
+    /// The layout of the given varyings; `frame_set` is the texture coordinate set of the
+    /// derivative tangent frame, if the draw has one.
+    fn new(texcoords: [bool; 2], tangent: bool, color: bool, frame_set: Option<u32>) -> Self {
         let mut count = at::OPTIONAL;
         let mut take = |wanted: bool, size: usize| {
             wanted.then(|| {
@@ -70,10 +75,14 @@ impl VaryingLayout {
         let texcoords = [take(texcoords[0], 2), take(texcoords[1], 2)];
         let tangent = take(tangent, 4);
         let color = take(color, 4);
+        let frame_texcoord = frame_set
+            .and_then(|set| texcoords[(set as usize).min(1)])
+            .unwrap_or(0);
         Self {
             texcoords,
             tangent,
             color,
+            frame_texcoord,
             count,
         }
     }
@@ -240,7 +249,7 @@ impl<'a> PbrShader<'a> {
             pass,
             ids: (ids.0 as f32, ids.1 as f32),
             mirrored: Mat3::from_mat4(model).determinant() < 0.0,
-            layout: VaryingLayout::new([false; 2], false, false),
+            layout: VaryingLayout::new([false; 2], false, false, None),
         };
         shader.layout = shader.layout_for(true, false);
         shader
@@ -257,10 +266,16 @@ impl<'a> PbrShader<'a> {
     /// texture coordinate sets its textures read (the derivative frame reads the normal
     /// texture's), the tangents where a normal texture is bent, the colours.
     fn layout_for(&self, vertex_colors: bool, tangents: bool) -> VaryingLayout {
-        let bends = self.frame_texture().is_some();
         let frame_set = self.frame_texture().map(|b| b.texcoord);
-        let set = |s: u32| self.reads.reads_set(s) || (bends && !tangents && frame_set == Some(s));
-        VaryingLayout::new([set(0), set(1)], bends && tangents, vertex_colors)
+        let bends = frame_set.is_some();
+        let derivative_set = frame_set.filter(|_| !tangents);
+        let set = |s: u32| self.reads.reads_set(s) || derivative_set == Some(s);
+        VaryingLayout::new(
+            [set(0), set(1)],
+            bends && tangents,
+            vertex_colors,
+            derivative_set,
+        )
     }
 
     /// The texture whose coordinates orient the tangent frame, when the draw bends a normal:
@@ -579,7 +594,7 @@ impl PbrShader<'_> {
 
     /// The derivative tangent frame `[t, b]` around `ng`: `t_ = (∂v/∂y ∂p/∂x − ∂v/∂x ∂p/∂y) /
     /// det` with `det = ∂u/∂x ∂v/∂y − ∂u/∂y ∂v/∂x` (u, v: the coordinates of the
-    /// [frame texture](PbrShader::frame_texture)), `t = normalize(t_ − ng (ng·t_))` (0 where
+    /// [frame texture](PbrShader::frame_texture), [`VaryingLayout::frame_texcoord`]), `t = normalize(t_ − ng (ng·t_))` (0 where
     /// degenerate), `b = ±ng × t` (negative where the mapping is mirrored: `det < 0` on a front
     /// face, `det > 0` on a back face).
     #[inline(always)]
@@ -589,7 +604,7 @@ impl PbrShader<'_> {
         ng: [L::F32; 3],
     ) -> [[L::F32; 3]; 2] {
         let lanes = f.lanes();
-        let u = self.texcoord_varying(self.frame_texture().map_or(0, |b| b.texcoord));
+        let u = self.layout.frame_texcoord;
         let (du_dx, du_dy) = f.derivatives(u);
         let (dv_dx, dv_dy) = f.derivatives(u + 1);
         let mut dp_dx = [lanes.splat_f32(0.0); 3];
