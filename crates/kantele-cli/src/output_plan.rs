@@ -8,48 +8,16 @@
 //! form of reference (a `.glb`'s image URIs, `file://` URIs, MTL maps with options).
 
 use std::collections::HashMap;
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, bail, Result};
 
 use crate::scenes::Input;
 
 /// The identity of a path for comparisons: absolute, `.`/`..` resolved, symbolic links of the
-/// existing part followed.
+/// existing part followed ([`kantele_scene::resolved_path`]).
 pub fn identity(path: &Path) -> PathBuf {
-    if let Ok(p) = std::fs::canonicalize(path) {
-        return p;
-    }
-    let absolute = std::env::current_dir()
-        .map(|d| d.join(path))
-        .unwrap_or_else(|_| path.to_path_buf());
-    // Resolve the longest existing ancestor, then append the rest lexically.
-    let mut existing = absolute.clone();
-    let mut rest = Vec::new();
-    while !existing.exists() {
-        match (existing.file_name(), existing.parent()) {
-            (Some(name), Some(parent)) => {
-                rest.push(name.to_os_string());
-                existing = parent.to_path_buf();
-            }
-            _ => break,
-        }
-    }
-    let mut out = std::fs::canonicalize(&existing).unwrap_or(existing);
-    for part in rest.iter().rev() {
-        out.push(part);
-    }
-    let mut clean = PathBuf::new();
-    for c in out.components() {
-        match c {
-            Component::ParentDir => {
-                clean.pop();
-            }
-            Component::CurDir => {}
-            other => clean.push(other),
-        }
-    }
-    clean
+    kantele_scene::resolved_path(path)
 }
 
 /// The most bytes of a `.gltf`, `.obj` or `.mtl` text [`input_files`] reads to find the files

@@ -412,6 +412,14 @@ pub fn load_scene_with(path: &Path, options: &LoadOptions) -> Result<LoadedScene
     }
 }
 
+/// Where `path` leads, whether or not a file is there yet: its canonical form when it exists,
+/// else its longest existing ancestor's canonical form with the rest appended (`.` and `..`
+/// resolved by name). The loaders' read policy places paths this way; the command compares its
+/// outputs with the inputs by it.
+pub fn resolved_path(path: &Path) -> PathBuf {
+    read_policy::resolved(path)
+}
+
 /// OBJ or MTL text as the OBJ loader reads it: UTF-16 with a byte-order mark, UTF-8 (a
 /// byte-order mark dropped), else Latin-1; lines ending in `\` joined with the next. For tools
 /// that look into these files as the loader does (the command's guard against overwriting an

@@ -115,7 +115,7 @@ fn same_file(opened: &std::fs::File, path: &Path) -> bool {
 
 /// Where `path` leads: its canonical form when it exists, else its longest existing ancestor's
 /// canonical form with the rest appended (`.` and `..` resolved by name).
-fn resolved(path: &Path) -> PathBuf {
+pub(crate) fn resolved(path: &Path) -> PathBuf {
     if let Ok(real) = std::fs::canonicalize(path) {
         return real;
     }
