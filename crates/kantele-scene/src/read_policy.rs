@@ -122,31 +122,34 @@ pub(crate) fn resolved(path: &Path) -> PathBuf {
     let absolute = std::env::current_dir()
         .map(|d| d.join(path))
         .unwrap_or_else(|_| path.to_path_buf());
-    let mut existing = absolute.as_path();
+    // The longest existing ancestor, resolved; the rest appended, then `.` and `..` resolved
+    // by name over the whole path.
+    let mut existing = absolute.clone();
     let mut rest = Vec::new();
-    let base = loop {
-        if let Ok(real) = std::fs::canonicalize(existing) {
-            break real;
-        }
+    while !existing.exists() {
         match (existing.file_name(), existing.parent()) {
             (Some(name), Some(parent)) => {
                 rest.push(name.to_os_string());
-                existing = parent;
+                existing = parent.to_path_buf();
             }
-            _ => break PathBuf::new(),
-        }
-    };
-    let mut out = base;
-    for part in rest.iter().rev() {
-        match part.to_str() {
-            Some("..") => {
-                out.pop();
-            }
-            Some(".") => {}
-            _ => out.push(part),
+            _ => break,
         }
     }
-    out
+    let mut out = std::fs::canonicalize(&existing).unwrap_or(existing);
+    for part in rest.iter().rev() {
+        out.push(part);
+    }
+    let mut clean = PathBuf::new();
+    for c in out.components() {
+        match c {
+            std::path::Component::ParentDir => {
+                clean.pop();
+            }
+            std::path::Component::CurDir => {}
+            other => clean.push(other),
+        }
+    }
+    clean
 }
 
 /// Why [`read_opened`] read nothing.

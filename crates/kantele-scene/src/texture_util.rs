@@ -148,28 +148,11 @@ pub fn checker(size: u32, squares: u32, a: [u8; 3], b: [u8; 3]) -> Texture {
         .expect("a clamped checker size is always valid")
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+/// Reads an encoded image's size from its header.
+pub(crate) type ImageSizeReader = fn(&[u8]) -> Result<(u32, u32), ImageError>;
 
-    #[test]
-    fn checker_has_the_asked_size_and_two_colours() {
-        let t = checker(256, 8, [255, 255, 255], [0, 0, 0]);
-        assert_eq!((t.width(), t.height()), (256, 256));
-        assert_eq!(t.levels().len(), 9);
-        let level = t.level(0).expect("level 0");
-        assert_eq!(level.texel(0, 0).x, 1.0);
-        assert_eq!(level.texel(32, 0).x, 0.0);
-        assert_eq!(level.texel(0, 32).x, 0.0);
-        assert_eq!(level.texel(32, 32).x, 1.0);
-    }
-
-    #[test]
-    fn garbage_does_not_decode() {
-        assert!(decode_srgb(b"not an image at all", None).is_err());
-        assert!(decode_srgb(b"\x89PNG\r\n\x1a\n broken", Some("image/png")).is_err());
-    }
-}
+/// Decodes an encoded image into a texture in a colour space, charging the budget.
+pub(crate) type ImageDecoder = fn(&[u8], ColorSpace, &mut Budget) -> Result<Texture, ImageError>;
 
 /// Body of the fuzz targets of an image decoder (`ktx2`, `dds`): reads the size with `size`
 /// and decodes the bytes with `decode` under a 64 MiB budget. An error is a valid outcome when
@@ -179,8 +162,8 @@ mod tests {
 pub(crate) fn fuzz_image_decoder(
     data: &[u8],
     malformed: &str,
-    size: fn(&[u8]) -> Result<(u32, u32), ImageError>,
-    decode: fn(&[u8], ColorSpace, &mut Budget) -> Result<Texture, ImageError>,
+    size: ImageSizeReader,
+    decode: ImageDecoder,
 ) {
     let check = |error: &ImageError| {
         let (ImageError::Budget(message) | ImageError::Decode(message)) = error;
@@ -208,5 +191,28 @@ pub(crate) fn fuzz_image_decoder(
             assert_eq!((texture.width(), texture.height()), declared);
         }
         Err(e) => check(&e),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn checker_has_the_asked_size_and_two_colours() {
+        let t = checker(256, 8, [255, 255, 255], [0, 0, 0]);
+        assert_eq!((t.width(), t.height()), (256, 256));
+        assert_eq!(t.levels().len(), 9);
+        let level = t.level(0).expect("level 0");
+        assert_eq!(level.texel(0, 0).x, 1.0);
+        assert_eq!(level.texel(32, 0).x, 0.0);
+        assert_eq!(level.texel(0, 32).x, 0.0);
+        assert_eq!(level.texel(32, 32).x, 1.0);
+    }
+
+    #[test]
+    fn garbage_does_not_decode() {
+        assert!(decode_srgb(b"not an image at all", None).is_err());
+        assert!(decode_srgb(b"\x89PNG\r\n\x1a\n broken", Some("image/png")).is_err());
     }
 }

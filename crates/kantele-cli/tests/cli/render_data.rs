@@ -423,15 +423,13 @@ fn a_near_plane_too_close_is_raised() {
         .flat_map(|f| f.to_le_bytes())
         .collect();
     std::fs::write(dir.path("z.bin"), &positions).unwrap();
-    let gltf = format!(
-        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0,1]}}],
-"nodes":[{{"mesh":0}},{{"camera":0}}],
-"cameras":[{{"type":"perspective","perspective":{{"yfov":0.8,"znear":1e-7}}}}],
-"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
-"buffers":[{{"byteLength":36,"uri":"z.bin"}}],
-"bufferViews":[{{"buffer":0,"byteLength":36}}],
-"accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[-1,-1,-3],"max":[1,1,-3]}}]}}"#
-    );
+    let gltf = r#"{"asset":{"version":"2.0"},"scene":0,"scenes":[{"nodes":[0,1]}],
+"nodes":[{"mesh":0},{"camera":0}],
+"cameras":[{"type":"perspective","perspective":{"yfov":0.8,"znear":1e-7}}],
+"meshes":[{"primitives":[{"attributes":{"POSITION":0}}]}],
+"buffers":[{"byteLength":36,"uri":"z.bin"}],
+"bufferViews":[{"buffer":0,"byteLength":36}],
+"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[-1,-1,-3],"max":[1,1,-3]}]}"#;
     std::fs::write(dir.path("z.gltf"), gltf).unwrap();
     let o = kantele(&[
         "render",
