@@ -5,7 +5,7 @@ use glam::{Mat4, Vec3};
 use kantele::backend::{FrameView, Pass};
 use kantele::scene::Scene;
 use kantele_output::pose::{
-    self, sidecar::SidecarCamera, Bounds, CameraPose, Intrinsics, PoseError, Projection, UpAxis,
+    self, sidecar::SidecarCamera, CameraPose, Intrinsics, PoseError, Projection, Silhouette, UpAxis,
 };
 use numpy::ndarray::Array2;
 use numpy::{IntoPyArray, PyArray2, PyReadonlyArray2, PyUntypedArrayMethods};
@@ -135,10 +135,10 @@ pub fn orbit(
     elevation_deg: f32,
     yfov_deg: f32,
 ) -> Result<Vec<CameraPose>, PoseError> {
-    let bounds = Bounds::of_scene(scene)
+    let silhouette = Silhouette::of_scene(scene)
         .ok_or_else(|| PoseError("the scene draws nothing, so there is nothing to orbit".into()))?;
     CameraPose::orbit(
-        &bounds,
+        &silhouette,
         views,
         elevation_deg,
         None,
@@ -157,10 +157,10 @@ pub fn framing(
     height: u32,
     yfov_deg: f32,
 ) -> Result<CameraPose, PoseError> {
-    let bounds = Bounds::of_scene(scene)
+    let silhouette = Silhouette::of_scene(scene)
         .ok_or_else(|| PoseError("the scene draws nothing, so there is nothing to frame".into()))?;
-    CameraPose::frame_bounds(
-        &bounds,
+    CameraPose::frame(
+        &silhouette,
         direction,
         UpAxis::Y,
         yfov_deg.to_radians(),

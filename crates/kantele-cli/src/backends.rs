@@ -11,8 +11,8 @@ use crate::cli::{BackendKind, CpuArgs};
 pub fn make_backend(kind: BackendKind, cpu: &CpuArgs, fast: bool) -> Result<Box<dyn Backend>> {
     let mut backend = make_plain_backend(kind, cpu, fast)?;
     backend
-        .set_samples(cpu.msaa)
-        .map_err(|e| anyhow!("--msaa {}: {e}", cpu.msaa))?;
+        .set_samples(cpu.samples())
+        .map_err(|e| anyhow!("--msaa {}: {e}", cpu.samples()))?;
     Ok(backend)
 }
 

@@ -5,7 +5,7 @@ use anyhow::{anyhow, bail, Result};
 use glam::Vec3;
 use kantele::scene::NamedCamera;
 use kantele_output::pose::sidecar::{read_views_file, ViewDefaults};
-use kantele_output::pose::{Bounds, CameraPose, UpAxis};
+use kantele_output::pose::{Bounds, CameraPose, Silhouette, UpAxis};
 use kantele_scene::LoadedScene;
 
 use crate::cli::{CameraArgs, UpArg};
@@ -26,7 +26,7 @@ pub enum CameraSpec {
     FileIndex(usize),
     /// The file's camera with this name.
     FileName(String),
-    /// Frame the scene's bounding box, ignoring the file's cameras.
+    /// Frame the model by its silhouette, ignoring the file's cameras.
     Auto,
     /// A camera at `eye` looking at `target`.
     LookAt {
@@ -199,14 +199,14 @@ impl CameraPlan {
         if let Some(views) = &self.views {
             return Ok(views.clone());
         }
-        let bounds = || {
-            Bounds::of_scene(&loaded.scene).ok_or_else(|| {
+        let silhouette = || {
+            Silhouette::of_scene(&loaded.scene).ok_or_else(|| {
                 anyhow!("{label}: the scene draws nothing, so there is nothing to frame")
             })
         };
         if let Some(n) = self.orbit {
             return CameraPose::orbit(
-                &bounds()?,
+                &silhouette()?,
                 n,
                 self.elevation,
                 self.radius,
@@ -238,7 +238,7 @@ impl CameraPlan {
         };
         let pose = match &self.spec {
             None if loaded.info.camera_from_file => file_camera()?,
-            None | Some(CameraSpec::Auto) => self.auto(&bounds()?, width, height, label)?,
+            None | Some(CameraSpec::Auto) => self.auto(&silhouette()?, width, height, label)?,
             Some(CameraSpec::FileIndex(i)) => numbered_camera(*i, &i.to_string())?,
             Some(CameraSpec::FileName(name)) => {
                 let i = cameras
@@ -267,15 +267,21 @@ impl CameraPlan {
         Ok(vec![pose])
     }
 
-    fn auto(&self, bounds: &Bounds, width: u32, height: u32, label: &str) -> Result<CameraPose> {
+    fn auto(
+        &self,
+        silhouette: &Silhouette,
+        width: u32,
+        height: u32,
+        label: &str,
+    ) -> Result<CameraPose> {
         let dir = self.up.direction(
             AUTO_AZIMUTH_DEG.to_radians(),
             AUTO_ELEVATION_DEG.to_radians(),
         );
         let pose = if self.ortho {
-            CameraPose::frame_bounds_orthographic(bounds, dir.as_vec3(), self.up, width, height)
+            CameraPose::frame_orthographic(silhouette, dir.as_vec3(), self.up, width, height)
         } else {
-            CameraPose::frame_bounds(bounds, dir.as_vec3(), self.up, self.yfov, width, height)
+            CameraPose::frame(silhouette, dir.as_vec3(), self.up, self.yfov, width, height)
         };
         pose.map_err(|e| anyhow!("{label}: camera: {}", e.0))
     }

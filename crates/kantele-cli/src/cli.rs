@@ -54,9 +54,17 @@ pub struct ThumbnailArgs {
     /// Width and height in pixels.
     #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub size: u32,
-    /// What to draw of the file.
+    /// How the file is read, shaded and posed.
     #[command(flatten)]
-    pub choice: ChoiceArgs,
+    pub load: LoadArgs,
+    /// CPU backend options (a thumbnail is multisampled 4× unless --msaa says otherwise).
+    #[command(flatten)]
+    pub cpu: CpuArgs,
+    /// The camera (default: `auto`, the model framed by its silhouette) and the background
+    /// (default: transparent). A thumbnail is one picture: `--orbit` and `--views` belong to
+    /// `render`.
+    #[command(flatten)]
+    pub camera: CameraArgs,
 }
 
 /// Which scenes to work on: files and built-in scenes.
@@ -69,6 +77,14 @@ pub struct SceneArgs {
     /// A built-in scene (cube, teapot, ground, pixel-edges, pbr-spheres, pbr-lights); may be repeated. Built-ins come after the files.
     #[arg(long = "builtin", value_name = "NAME")]
     pub builtins: Vec<String>,
+    /// How the files are read, shaded and posed.
+    #[command(flatten)]
+    pub load: LoadArgs,
+}
+
+/// How scene files are read (budgets, read policy), shaded and posed: shared by every command.
+#[derive(Debug, Args, Clone)]
+pub struct LoadArgs {
     /// Fail on problems that are otherwise warnings (a texture file missing or undecodable).
     #[arg(long)]
     pub strict: bool,
@@ -296,13 +312,21 @@ pub struct CpuArgs {
     #[arg(long, value_name = "SECONDS", value_parser = parse_timeout)]
     pub timeout: Option<std::time::Duration>,
     /// Multisample antialiasing: samples per pixel, 1, 4 or 8 (colour only: depth, ids and
-    /// normals stay per pixel). Every backend draws it; llvmpipe's OpenGL offers at most 4.
-    #[arg(long, value_name = "N", default_value_t = SampleCount::X1, value_parser = parse_msaa)]
-    pub msaa: SampleCount,
+    /// normals stay per pixel); default 1, for `thumbnail` 4. Every backend draws it;
+    /// llvmpipe's OpenGL offers at most 4.
+    #[arg(long, value_name = "N", value_parser = parse_msaa)]
+    pub msaa: Option<SampleCount>,
     /// CPU colour target: f32 (linear floats, exact) or srgb8 (8-bit sRGB, a quarter of the
     /// colour memory; the same 8-bit pictures). Normals and ids always use f32.
     #[arg(long, value_name = "FORMAT", default_value_t = TargetFormat::LinearF32, value_parser = parse_target)]
     pub target: TargetFormat,
+}
+
+impl CpuArgs {
+    /// Samples per pixel: `--msaa`, else 1.
+    pub fn samples(&self) -> SampleCount {
+        self.msaa.unwrap_or(SampleCount::X1)
+    }
 }
 
 /// Parses `--target`: f32 or srgb8.
@@ -382,7 +406,7 @@ pub struct RenderArgs {
 /// Which cameras `render` uses, and the background.
 #[derive(Debug, Args, Clone, Default)]
 pub struct CameraArgs {
-    /// The camera: `N` or `NAME` (a camera of the file), `auto` (frame the bounding box,
+    /// The camera: `N` or `NAME` (a camera of the file), `auto` (frame the model by its silhouette,
     /// ignoring the file's cameras) or `look-at:EYE:TARGET[:UP]` (comma-separated x,y,z).
     /// Default: the file's first camera, else `auto`.
     #[arg(long, value_name = "SPEC", conflicts_with_all = ["views", "orbit"])]
@@ -390,7 +414,7 @@ pub struct CameraArgs {
     /// Vertical field of view in degrees of `auto`, `look-at` and orbit cameras (default 45).
     #[arg(long, value_name = "DEG", value_parser = parse_fov)]
     pub fov: Option<f32>,
-    /// Frame the bounding box with an orthographic camera (the `auto` framing, from the same
+    /// Frame the model with an orthographic camera (the `auto` framing, from the same
     /// direction; implies `--camera auto`, which is the only camera it combines with).
     #[arg(long, conflicts_with_all = ["fov", "views", "orbit"])]
     pub ortho: bool,
@@ -398,7 +422,7 @@ pub struct CameraArgs {
     /// list of poses (see --help).
     #[arg(long, value_name = "FILE", conflicts_with = "orbit")]
     pub views: Option<PathBuf>,
-    /// Render N views on a circle around the scene's bounding box, written as numbered images
+    /// Render N views on a circle around the centre of the scene's box, written as numbered images
     /// ({frame}), or as one animated image when -o is .gif or .apng.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=100000))]
     pub orbit: Option<u32>,
@@ -411,7 +435,8 @@ pub struct CameraArgs {
         requires = "orbit"
     )]
     pub elevation: f32,
-    /// Orbit radius in scene units (default: the bounding sphere fills the picture).
+    /// Orbit radius in scene units (default: the nearest from which the model stays inside 92%
+    /// of the picture at every azimuth).
     #[arg(long, value_name = "R", requires = "orbit")]
     pub radius: Option<f32>,
     /// Up axis of `auto` framing and orbits.

@@ -538,7 +538,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     let mut scene_args = args.input.clone();
     if let Some((start, _)) = args.time_range {
         // Loaded at the range's first time: the cameras frame that pose.
-        scene_args.choice.time = Some(start);
+        scene_args.load.choice.time = Some(start);
     }
     let inputs = scenes::inputs(&scene_args)?;
     let cameras = CameraPlan::new(&args.camera, args.size)?;
@@ -581,7 +581,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             loaded.scene.clear_color = glam::Vec4::from_array(c);
         }
         let player = loaded.animation.take();
-        let time = scene_args.choice.time.unwrap_or(0.0);
+        let time = scene_args.load.choice.time.unwrap_or(0.0);
         let mut job = SceneJob {
             args,
             input,

@@ -9,7 +9,7 @@ use kantele::shade::pbr::Tonemap;
 use kantele::state::CullMode;
 use kantele_scene::{EnvironmentChoice, LoadError, LoadOptions, LoadedScene};
 
-use crate::cli::{CullArg, SceneArgs, ShadingArg, TonemapArg};
+use crate::cli::{CullArg, LoadArgs, SceneArgs, ShadingArg, TonemapArg};
 
 /// One scene to load.
 #[derive(Clone, Debug)]
@@ -130,46 +130,7 @@ fn pattern_scenes(pattern: &str) -> Result<Vec<PathBuf>> {
 /// built-ins are known before anything is rendered.
 pub fn inputs(args: &SceneArgs) -> Result<Vec<Input>> {
     let mut out = Vec::new();
-    let options = LoadOptions {
-        max_memory: args.max_memory.unwrap_or(kantele_scene::DEFAULT_MAX_MEMORY),
-        allow_read: args.allow_read.clone(),
-        strict: args.strict,
-        shading: match args.shading {
-            ShadingArg::Auto => None,
-            ShadingArg::Lambert => Some(Shading::Lambert),
-            ShadingArg::Pbr => Some(Shading::Pbr),
-        },
-        environment: match args.environment.as_deref() {
-            None => EnvironmentChoice::Default,
-            Some("studio") => EnvironmentChoice::Studio,
-            Some("none") => EnvironmentChoice::None,
-            Some(file) => {
-                let path = PathBuf::from(file);
-                if !path.is_file() {
-                    bail!("--environment {file}: no such file (or use studio, none)");
-                }
-                EnvironmentChoice::File(path)
-            }
-        },
-        environment_intensity: args.environment_intensity,
-        environment_rotation_degrees: args.environment_rotation,
-        exposure: args.exposure,
-        tonemap: match args.tonemap {
-            TonemapArg::None => Tonemap::None,
-            TonemapArg::PbrNeutral => Tonemap::PbrNeutral,
-            TonemapArg::Aces => Tonemap::Aces,
-        },
-        scene: args.choice.scene.as_deref().map(parse_choice),
-        variant: args.choice.variant.clone(),
-        animation: args.choice.animation.as_deref().map(parse_choice),
-        time: args.choice.time.unwrap_or(0.0),
-        cull: args.choice.cull.map(|c| match c {
-            CullArg::Back => CullMode::Back,
-            CullArg::Front => CullMode::Front,
-            CullArg::None => CullMode::None,
-        }),
-        ..LoadOptions::default()
-    };
+    let options = load_options(&args.load)?;
     let file = |p: PathBuf| Input::File(p, options.clone());
     for p in &args.scenes {
         match std::fs::metadata(p) {
@@ -223,4 +184,48 @@ impl Warnings {
             }
         }
     }
+}
+
+/// The loader's options from the command's load flags.
+fn load_options(args: &LoadArgs) -> Result<LoadOptions> {
+    Ok(LoadOptions {
+        max_memory: args.max_memory.unwrap_or(kantele_scene::DEFAULT_MAX_MEMORY),
+        allow_read: args.allow_read.clone(),
+        strict: args.strict,
+        shading: match args.shading {
+            ShadingArg::Auto => None,
+            ShadingArg::Lambert => Some(Shading::Lambert),
+            ShadingArg::Pbr => Some(Shading::Pbr),
+        },
+        environment: match args.environment.as_deref() {
+            None => EnvironmentChoice::Default,
+            Some("studio") => EnvironmentChoice::Studio,
+            Some("none") => EnvironmentChoice::None,
+            Some(file) => {
+                let path = PathBuf::from(file);
+                if !path.is_file() {
+                    bail!("--environment {file}: no such file (or use studio, none)");
+                }
+                EnvironmentChoice::File(path)
+            }
+        },
+        environment_intensity: args.environment_intensity,
+        environment_rotation_degrees: args.environment_rotation,
+        exposure: args.exposure,
+        tonemap: match args.tonemap {
+            TonemapArg::None => Tonemap::None,
+            TonemapArg::PbrNeutral => Tonemap::PbrNeutral,
+            TonemapArg::Aces => Tonemap::Aces,
+        },
+        scene: args.choice.scene.as_deref().map(parse_choice),
+        variant: args.choice.variant.clone(),
+        animation: args.choice.animation.as_deref().map(parse_choice),
+        time: args.choice.time.unwrap_or(0.0),
+        cull: args.choice.cull.map(|c| match c {
+            CullArg::Back => CullMode::Back,
+            CullArg::Front => CullMode::Front,
+            CullArg::None => CullMode::None,
+        }),
+        ..LoadOptions::default()
+    })
 }

@@ -1,5 +1,6 @@
-//! `kantele thumbnail IN OUT --size N`: a square PNG of a scene framed by its bounding box on a
-//! transparent background, for file managers (`data/kantele.thumbnailer`).
+//! `kantele thumbnail IN OUT --size N`: a square PNG of a scene framed by its silhouette on a
+//! transparent background, for file managers (`data/kantele.thumbnailer`); the load, CPU and
+//! camera options of `render` apply.
 
 use std::sync::Arc;
 
@@ -10,25 +11,19 @@ use kantele_output::output::{encode_png_rgba8, write_atomic};
 
 use crate::backends::make_backend;
 use crate::camera_args::CameraPlan;
-use crate::cli::{BackendKind, CameraArgs, CpuArgs, ThumbnailArgs};
+use crate::cli::{BackendKind, CameraArgs, CpuArgs, SceneArgs, ThumbnailArgs};
 use crate::output_plan::{create_folder, OutputGuard};
 use crate::scenes::{self, Input};
 
 /// Runs `kantele thumbnail`.
 pub fn run(args: &ThumbnailArgs) -> Result<()> {
-    let mut found = scenes::inputs(&crate::cli::SceneArgs {
+    if args.camera.orbit.is_some() || args.camera.views.is_some() {
+        anyhow::bail!("a thumbnail is one picture: --orbit and --views belong to `kantele render`");
+    }
+    let mut found = scenes::inputs(&SceneArgs {
         scenes: vec![args.input.clone()],
         builtins: Vec::new(),
-        strict: false,
-        max_memory: None,
-        allow_read: Vec::new(),
-        shading: crate::cli::ShadingArg::Auto,
-        environment: None,
-        environment_intensity: 1.0,
-        environment_rotation: 0.0,
-        exposure: 0.0,
-        tonemap: crate::cli::TonemapArg::PbrNeutral,
-        choice: args.choice.clone(),
+        load: args.load.clone(),
     })?;
     if found.len() != 1 {
         anyhow::bail!(
@@ -48,20 +43,20 @@ pub fn run(args: &ThumbnailArgs) -> Result<()> {
     let label = input.label();
     let mut loaded = input.load()?;
     guard.check_reads(&label, &loaded.info.files_read)?;
-    loaded.scene.clear_color = glam::Vec4::ZERO;
-    let plan = CameraPlan::new(
-        &CameraArgs {
-            camera: Some("auto".into()),
-            ..Default::default()
-        },
-        None,
-    )?;
+    let mut warnings = scenes::Warnings::default();
+    warnings.report(&loaded, |w| eprintln!("{w}"));
+    loaded.scene.clear_color = glam::Vec4::from_array(args.camera.background.unwrap_or([0.0; 4]));
+    // The model framed by its silhouette unless --camera names another camera.
+    let camera = CameraArgs {
+        camera: args.camera.camera.clone().or_else(|| Some("auto".into())),
+        ..args.camera.clone()
+    };
+    let plan = CameraPlan::new(&camera, None)?;
     let pose = plan.poses(&loaded, args.size, args.size, &label)?.remove(0);
     let scene = Arc::new(loaded.scene);
-    // The preset antialiases: 4 samples per pixel.
     let cpu = CpuArgs {
-        msaa: SampleCount::X4,
-        ..CpuArgs::default()
+        msaa: Some(args.cpu.msaa.unwrap_or(SampleCount::X4)),
+        ..args.cpu.clone()
     };
     let mut backend = make_backend(BackendKind::Cpu, &cpu, false)?;
     backend

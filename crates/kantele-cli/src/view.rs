@@ -122,7 +122,7 @@ impl App {
         let mut b = CpuBackend::new(CpuOptions {
             threads: self.args.cpu.threads,
             strategy,
-            samples: self.args.cpu.msaa,
+            samples: self.args.cpu.samples(),
             target: self.args.cpu.target,
             ..CpuOptions::default()
         })

@@ -180,3 +180,61 @@ fn patched_reference_files_bad_indices_and_nan_positions() {
     let img = image::open(dir.path("nan.png")).expect("png").to_rgba8();
     assert_eq!(img.dimensions(), (192, 192));
 }
+
+/// The box of a picture's non-transparent pixels: (left, top, right, bottom), exclusive ends.
+fn opaque_box(img: &image::RgbaImage) -> Option<(u32, u32, u32, u32)> {
+    let mut found: Option<(u32, u32, u32, u32)> = None;
+    for (x, y, p) in img.enumerate_pixels() {
+        if p.0[3] > 0 {
+            found = Some(match found {
+                None => (x, y, x + 1, y + 1),
+                Some((l, t, r, b)) => (l.min(x), t.min(y), r.max(x + 1), b.max(y + 1)),
+            });
+        }
+    }
+    found
+}
+
+/// A thumbnail of every reference scene fills its picture with the model: the model spans at
+/// least 85% of the picture along its tighter direction (the framing aims at 92%) and is
+/// centred within 3 pixels both ways.
+#[test]
+fn thumbnails_fill_and_centre_every_reference_scene() {
+    let Some(scenes) = shared_scenes() else {
+        return;
+    };
+    let dir = TempDir::new("thumbs");
+    let mut names: Vec<_> = std::fs::read_dir(&scenes)
+        .expect("scenes folder")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "glb"))
+        .collect();
+    names.sort();
+    assert!(names.len() >= 18, "{} scenes", names.len());
+    let size = 256u32;
+    for scene in &names {
+        let stem = scene.file_stem().unwrap().to_string_lossy().into_owned();
+        let out = dir.path(&format!("{stem}.png"));
+        let o = kantele(&[
+            "thumbnail",
+            &scene.to_string_lossy(),
+            &out.to_string_lossy(),
+            "--size",
+            &size.to_string(),
+        ]);
+        ok(&o);
+        let img = image::open(&out).unwrap().to_rgba8();
+        let (l, t, r, b) = opaque_box(&img).unwrap_or_else(|| panic!("{stem}: empty"));
+        let span = (r - l).max(b - t) as f64 / size as f64;
+        assert!(
+            span >= 0.85,
+            "{stem}: the model spans {span:.3} of the picture"
+        );
+        let centre = size as f64 / 2.0;
+        let (cx, cy) = ((l + r) as f64 / 2.0, (t + b) as f64 / 2.0);
+        assert!(
+            (cx - centre).abs() <= 3.0 && (cy - centre).abs() <= 3.0,
+            "{stem}: centred at ({cx}, {cy}), box {l},{t}..{r},{b}"
+        );
+    }
+}

@@ -147,12 +147,6 @@ pub(crate) fn depth_range(distance: f64, radius: f64) -> (f64, f64) {
     (near, distance + radius * 2.0)
 }
 
-/// Half of the smaller of the two field-of-view angles of a `yfov` camera on an image of
-/// `aspect`.
-fn half_min_fov(yfov: f64, aspect: f64) -> f64 {
-    0.5 * yfov.min(2.0 * (aspect * (0.5 * yfov).tan()).atan())
-}
-
 fn check_yfov(yfov: f32) -> Result<f64, PoseError> {
     if yfov > 0.0 && yfov < std::f32::consts::PI {
         Ok(yfov as f64)
@@ -170,23 +164,88 @@ fn check_size(width: u32, height: u32) -> Result<f64, PoseError> {
     Ok(width as f64 / height as f64)
 }
 
-/// A box seen from a framing direction: the camera basis the framed camera will have
-/// ([`look_at_f64`] picks the same) and the box's corners in it, relative to the box's centre in
-/// units of its radius.
-struct BoxInView {
-    /// Unit vector from the box towards the eye.
+/// Largest number of points a [`Silhouette`] of a scene keeps: draws beyond it are framed by the
+/// eight corners of their boxes (bounded work and memory for scenes of many large instances).
+pub const MAX_SILHOUETTE_POINTS: usize = 4 << 20;
+
+/// What a framing fits into the picture: a model's points in world space — the vertices of
+/// everything a scene draws, so that the framing follows the model's projected silhouette, not
+/// its bounding box — and the box around them.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Silhouette {
+    points: Vec<DVec3>,
+    bounds: Bounds,
+}
+
+impl Silhouette {
+    /// The finite points among `points` (`None` when there is none).
+    pub fn from_points(points: impl IntoIterator<Item = DVec3>) -> Option<Self> {
+        let points: Vec<DVec3> = points.into_iter().filter(|p| p.is_finite()).collect();
+        let bounds = Bounds::from_points(points.iter().copied())?;
+        Some(Self { points, bounds })
+    }
+
+    /// A box's eight corners.
+    pub fn of_bounds(bounds: &Bounds) -> Self {
+        Self {
+            points: bounds.corners().to_vec(),
+            bounds: *bounds,
+        }
+    }
+
+    /// Every vertex the scene draws, placed by its draw's transform (up to
+    /// [`MAX_SILHOUETTE_POINTS`]; the draws beyond by their boxes' corners); `None` when nothing
+    /// finite is drawn.
+    pub fn of_scene(scene: &Scene) -> Option<Self> {
+        let mut points = Vec::new();
+        for draw in &scene.draws {
+            let Some(mesh) = scene.meshes.get(draw.mesh) else {
+                continue;
+            };
+            let model = draw.model.as_dmat4();
+            if points.len() + mesh.positions.len() <= MAX_SILHOUETTE_POINTS {
+                points.extend(
+                    mesh.positions
+                        .iter()
+                        .map(|p| model.transform_point3(p.as_dvec3())),
+                );
+            } else if let Some((a, b)) = mesh.bounds() {
+                let corners = Bounds {
+                    min: a.as_dvec3(),
+                    max: b.as_dvec3(),
+                }
+                .corners();
+                points.extend(corners.map(|c| model.transform_point3(c)));
+            }
+        }
+        Self::from_points(points)
+    }
+
+    /// The box around the points.
+    pub fn bounds(&self) -> &Bounds {
+        &self.bounds
+    }
+
+    /// The points.
+    pub fn points(&self) -> &[DVec3] {
+        &self.points
+    }
+}
+
+/// The camera basis a framing from one direction will have ([`look_at_f64`] picks the same), in
+/// which points are measured relative to the model's centre in units of its size.
+struct ViewBasis {
+    /// Unit vector from the model towards the eye.
     back: DVec3,
     /// The camera's right and up axes.
     right: DVec3,
     cam_up: DVec3,
-    /// The box's centre and radius (world units).
+    /// The model's centre and size (world units).
     center: DVec3,
     scale: f64,
-    /// Corners as (right, up, back) coordinates, in radii from the centre.
-    corners: [DVec3; 8],
 }
 
-impl BoxInView {
+impl ViewBasis {
     fn new(bounds: &Bounds, from_dir: Vec3, up: UpAxis) -> Result<Self, PoseError> {
         if !bounds.min.is_finite() || !bounds.max.is_finite() {
             return Err(err("the bounds to frame are not finite"));
@@ -204,85 +263,113 @@ impl BoxInView {
         };
         let right = up_hint.cross(back).normalize();
         let cam_up = back.cross(right);
-        let scale = bounds.scale();
-        let center = bounds.center();
-        let corners = bounds.corners().map(|p| {
-            let q = (p - center) / scale;
-            DVec3::new(q.dot(right), q.dot(cam_up), q.dot(back))
-        });
         Ok(Self {
             back,
             right,
             cam_up,
-            center,
-            scale,
-            corners,
+            center: bounds.center(),
+            scale: bounds.scale(),
         })
+    }
+
+    /// A point as (right, up, back) coordinates, in model sizes from the centre.
+    fn coords(&self, p: DVec3) -> DVec3 {
+        let q = (p - self.center) / self.scale;
+        DVec3::new(q.dot(self.right), q.dot(self.cam_up), q.dot(self.back))
+    }
+
+    /// The world point at view coordinates `(x, y, z)`.
+    fn world(&self, x: f64, y: f64, z: f64) -> DVec3 {
+        self.center + (self.right * x + self.cam_up * y + self.back * z) * self.scale
     }
 }
 
+/// Tangents of the half field-of-view angles a framing fills: horizontal and vertical.
+fn fill_tangents(yfov: f64, aspect: f64) -> (f64, f64) {
+    let ty = (0.5 * yfov).tan() * FRAMING_FILL;
+    (ty * aspect, ty)
+}
+
 impl CameraPose {
-    /// A perspective camera that looks at `bounds` from direction `from_dir` (centre towards
-    /// the eye) and makes the box fill the picture: every corner inside the image and the box
-    /// spanning [`FRAMING_FILL`] of it along its tighter direction, centred. The depth range
-    /// holds the whole box.
-    pub fn frame_bounds(
-        bounds: &Bounds,
+    /// A perspective camera that looks at `silhouette` from direction `from_dir` (model
+    /// towards the eye) and makes it fill the picture: every point inside the image, the
+    /// projection spanning [`FRAMING_FILL`] of the image along its tighter direction and centred
+    /// along both. The depth range holds every point.
+    ///
+    /// In the view basis, a camera at `(cx, cy, e)` sees point `(x, y, z)` inside the half-angle
+    /// tangent `t` horizontally when `|x − cx| ≤ t (e − z)`, that is `cx + t e ≥ max(x + t z)`
+    /// and `t e − cx ≥ max(t z − x)`: the nearest such camera is in closed form, per direction;
+    /// the farther of the two wins, and the looser direction is then centred.
+    pub fn frame(
+        silhouette: &Silhouette,
         from_dir: Vec3,
         up: UpAxis,
         yfov: f32,
         width: u32,
         height: u32,
     ) -> Result<Self, PoseError> {
-        let yfov_f = check_yfov(yfov)?;
-        let aspect = check_size(width, height)?;
-        let BoxInView {
-            back,
-            right,
-            cam_up,
-            center,
-            scale,
-            corners,
-        } = BoxInView::new(bounds, from_dir, up)?;
-        let ty = (0.5 * yfov_f).tan() * FRAMING_FILL;
-        let tx = (0.5 * yfov_f).tan() * aspect * FRAMING_FILL;
-        // Target offset in the image plane (right, up), re-centred a few times.
-        let (mut sx, mut sy) = (0.0f64, 0.0f64);
-        let mut distance = 0.0;
-        for _ in 0..8 {
-            distance = corners
-                .iter()
-                .map(|c| {
-                    let z = c.z;
-                    (z + (c.x - sx).abs() / tx).max(z + (c.y - sy).abs() / ty)
-                })
-                .fold(f64::NEG_INFINITY, f64::max);
-            let max_z = corners
-                .iter()
-                .map(|c| c.z)
-                .fold(f64::NEG_INFINITY, f64::max);
-            distance = distance.max(max_z + 1e-3);
-            // Projected extent (tangent units) and its middle.
-            let (mut lo_x, mut hi_x, mut lo_y, mut hi_y) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-            for c in &corners {
-                let depth = distance - c.z;
-                let (px, py) = ((c.x - sx) / depth, (c.y - sy) / depth);
-                lo_x = lo_x.min(px);
-                hi_x = hi_x.max(px);
-                lo_y = lo_y.min(py);
-                hi_y = hi_y.max(py);
+        let (tx, ty) = fill_tangents(check_yfov(yfov)?, check_size(width, height)?);
+        let basis = ViewBasis::new(silhouette.bounds(), from_dir, up)?;
+        let points = silhouette.points();
+        let mut reach = [f64::NEG_INFINITY; 5];
+        for p in points.iter().map(|&p| basis.coords(p)) {
+            let candidates = [
+                p.x + tx * p.z,
+                tx * p.z - p.x,
+                p.y + ty * p.z,
+                ty * p.z - p.y,
+                p.z,
+            ];
+            for (r, c) in reach.iter_mut().zip(candidates) {
+                *r = r.max(c);
             }
-            sx += (lo_x + hi_x) * 0.5 * distance;
-            sy += (lo_y + hi_y) * 0.5 * distance;
         }
-        let depths = corners.iter().map(|c| distance - c.z);
-        let nearest = depths.clone().fold(f64::INFINITY, f64::min);
-        let farthest = depths.fold(f64::NEG_INFINITY, f64::max);
-        let target = center + (right * sx + cam_up * sy) * scale;
-        let eye = target + back * (distance * scale);
+        let [right_x, left_x, top_y, bottom_y, front_z] = reach;
+        let distance = ((right_x + left_x) / (2.0 * tx))
+            .max((top_y + bottom_y) / (2.0 * ty))
+            .max(front_z + 1e-3);
+        let (mut sx, mut sy) = (0.5 * (right_x - left_x), 0.5 * (top_y - bottom_y));
+        // Centre the projection: exact already along the tight direction; a few steps along
+        // the other (each moves the extreme points, at their own depths, to symmetric places),
+        // whose slack leaves every point inside (FRAMING_FILL < 1).
+        let (mut nearest, mut farthest) = (f64::INFINITY, f64::NEG_INFINITY);
+        for _ in 0..6 {
+            // Per axis: the lowest and highest projection and the depths they lie at.
+            let mut extent = [
+                (f64::MAX, 1.0),
+                (f64::MIN, 1.0),
+                (f64::MAX, 1.0),
+                (f64::MIN, 1.0),
+            ];
+            (nearest, farthest) = (f64::INFINITY, f64::NEG_INFINITY);
+            for p in points.iter().map(|&p| basis.coords(p)) {
+                let depth = distance - p.z;
+                let (px, py) = ((p.x - sx) / depth, (p.y - sy) / depth);
+                for (slot, value, lower) in
+                    [(0, px, true), (1, px, false), (2, py, true), (3, py, false)]
+                {
+                    if (lower && value < extent[slot].0) || (!lower && value > extent[slot].0) {
+                        extent[slot] = (value, depth);
+                    }
+                }
+                nearest = nearest.min(depth);
+                farthest = farthest.max(depth);
+            }
+            let shift = |(lo, d_lo): (f64, f64), (hi, d_hi): (f64, f64)| {
+                (lo + hi) / (1.0 / d_lo + 1.0 / d_hi)
+            };
+            let (dx, dy) = (shift(extent[0], extent[1]), shift(extent[2], extent[3]));
+            sx += dx;
+            sy += dy;
+            if dx.abs().max(dy.abs()) <= distance * 1e-9 {
+                break;
+            }
+        }
+        let target = basis.world(sx, sy, 0.0);
+        let eye = basis.world(sx, sy, distance);
         let view = look_at_f64(eye, target, up.vector())?;
-        let near = (nearest * 0.5).max(distance * 1e-4) * scale;
-        let far = farthest * 2.0 * scale;
+        let near = (nearest * 0.5).max(distance * 1e-4) * basis.scale;
+        let far = farthest * 2.0 * basis.scale;
         CameraPose::new(
             width,
             height,
@@ -293,58 +380,41 @@ impl CameraPose {
         )
     }
 
-    /// An orthographic camera that looks at `bounds` from direction `from_dir` (centre towards
-    /// the eye) and makes the box fill the picture as [`CameraPose::frame_bounds`] does: the
-    /// box's projection centred and spanning [`FRAMING_FILL`] of the image along its tighter
-    /// direction (`ymag` chosen for that; pixels stay square). The eye sits one radius in front
-    /// of the box and the depth range holds all of it.
-    pub fn frame_bounds_orthographic(
-        bounds: &Bounds,
+    /// An orthographic camera that looks at `silhouette` from direction `from_dir` (model
+    /// towards the eye) and makes it fill the picture as [`CameraPose::frame`] does: the
+    /// projection centred and spanning [`FRAMING_FILL`] of the image along its tighter direction
+    /// (`ymag` chosen for that; pixels stay square). The eye sits one model size in front of the
+    /// nearest point and the depth range holds all of them.
+    pub fn frame_orthographic(
+        silhouette: &Silhouette,
         from_dir: Vec3,
         up: UpAxis,
         width: u32,
         height: u32,
     ) -> Result<Self, PoseError> {
         let aspect = check_size(width, height)?;
-        let BoxInView {
-            back,
-            right,
-            cam_up,
-            center,
-            scale,
-            corners,
-        } = BoxInView::new(bounds, from_dir, up)?;
-        let fold = |f: fn(&DVec3) -> f64, pick: fn(f64, f64) -> f64, start: f64| {
-            corners.iter().map(f).fold(start, pick)
-        };
-        let (lo_x, hi_x) = (
-            fold(|c| c.x, f64::min, f64::MAX),
-            fold(|c| c.x, f64::max, f64::MIN),
-        );
-        let (lo_y, hi_y) = (
-            fold(|c| c.y, f64::min, f64::MAX),
-            fold(|c| c.y, f64::max, f64::MIN),
-        );
-        let (lo_z, hi_z) = (
-            fold(|c| c.z, f64::min, f64::MAX),
-            fold(|c| c.z, f64::max, f64::MIN),
-        );
-        let half_x = 0.5 * (hi_x - lo_x);
-        let half_y = 0.5 * (hi_y - lo_y);
-        let ymag = (half_y.max(half_x / aspect) / FRAMING_FILL).max(1e-6);
-        let (sx, sy) = (0.5 * (lo_x + hi_x), 0.5 * (lo_y + hi_y));
-        // The eye one radius (in box units) in front of the nearest corner.
-        let distance = hi_z + 1.0;
-        let target = center + (right * sx + cam_up * sy) * scale;
-        let eye = target + back * (distance * scale);
+        let basis = ViewBasis::new(silhouette.bounds(), from_dir, up)?;
+        let (lo, hi) = silhouette
+            .points()
+            .iter()
+            .map(|&p| basis.coords(p))
+            .fold((DVec3::MAX, DVec3::MIN), |(lo, hi), p| {
+                (lo.min(p), hi.max(p))
+            });
+        let half = 0.5 * (hi - lo);
+        let ymag = (half.y.max(half.x / aspect) / FRAMING_FILL).max(1e-6);
+        let (sx, sy) = (0.5 * (lo.x + hi.x), 0.5 * (lo.y + hi.y));
+        let distance = hi.z + 1.0;
+        let target = basis.world(sx, sy, 0.0);
+        let eye = basis.world(sx, sy, distance);
         let view = look_at_f64(eye, target, up.vector())?;
-        let near = 0.5 * scale;
-        let far = (distance - lo_z + 1.0) * scale;
+        let near = 0.5 * basis.scale;
+        let far = (distance - lo.z + 1.0) * basis.scale;
         CameraPose::new(
             width,
             height,
             Projection::Orthographic {
-                ymag: (ymag * scale) as f32,
+                ymag: (ymag * basis.scale) as f32,
             },
             near as f32,
             Some(far as f32),
@@ -352,13 +422,19 @@ impl CameraPose {
         )
     }
 
-    /// `n` perspective cameras on a circle around the centre of `bounds`, all looking at it:
-    /// at `elevation_deg` above the horizon of `up`, azimuths `360° · k / n` from the front
-    /// (see [`UpAxis::direction`]), `radius` from the centre, or when `None` far enough that
-    /// the bounding sphere fits the picture.
+    /// `n` perspective cameras on a circle around the centre of `silhouette`'s box, all looking
+    /// at it: at `elevation_deg` above the horizon of `up`, azimuths `360° · k / n` from the
+    /// front (see [`UpAxis::direction`]), `radius` from the centre, or when `None` at the one
+    /// distance from which every point stays inside [`FRAMING_FILL`] of the picture at *every*
+    /// azimuth, so a turntable neither clips nor zooms.
+    ///
+    /// A point at height `h` over the centre and `r` from the up axis, seen from azimuth `φ`
+    /// away from its own, has view coordinates `z = r cos φ cos e + h sin e`, `x = r sin φ`,
+    /// `y = h cos e − r cos φ sin e`; the distance it needs, `max(z + |x|/tx, z + |y|/ty)`,
+    /// peaks over `φ` at `h sin e + r √(cos² e + 1/tx²)` and at `cos φ = ±1`.
     #[allow(clippy::too_many_arguments)]
     pub fn orbit(
-        bounds: &Bounds,
+        silhouette: &Silhouette,
         n: u32,
         elevation_deg: f32,
         radius: Option<f32>,
@@ -367,8 +443,7 @@ impl CameraPose {
         width: u32,
         height: u32,
     ) -> Result<Vec<Self>, PoseError> {
-        let yfov_f = check_yfov(yfov)?;
-        let aspect = check_size(width, height)?;
+        let (tx, ty) = fill_tangents(check_yfov(yfov)?, check_size(width, height)?);
         if n == 0 || n > MAX_ORBIT_VIEWS {
             return Err(err(format!(
                 "orbit of {n} views: use 1..={MAX_ORBIT_VIEWS}"
@@ -379,18 +454,37 @@ impl CameraPose {
                 "orbit elevation {elevation_deg}° is not finite"
             )));
         }
+        let bounds = silhouette.bounds();
         if !bounds.min.is_finite() || !bounds.max.is_finite() {
             return Err(err("the bounds to orbit are not finite"));
         }
         let center = bounds.center();
-        let sphere = bounds.scale();
+        let scale = bounds.scale();
+        let elevation = (elevation_deg as f64).to_radians();
+        let (sin_e, cos_e) = elevation.sin_cos();
+        let up_axis = up.vector();
+        // Per point: the distance it needs, and its nearest and farthest view depth offsets,
+        // over every azimuth (model sizes).
+        let (mut needed, mut front, mut back) = (0.0f64, f64::NEG_INFINITY, f64::INFINITY);
+        for &p in silhouette.points() {
+            let q = (p - center) / scale;
+            let h = q.dot(up_axis);
+            let r = (q - up_axis * h).length();
+            let sideways = h * sin_e + r * (cos_e * cos_e + 1.0 / (tx * tx)).sqrt();
+            let upright = [1.0, -1.0]
+                .map(|u: f64| r * u * cos_e + h * sin_e + (h * cos_e - r * u * sin_e).abs() / ty);
+            needed = needed.max(sideways).max(upright[0]).max(upright[1]);
+            front = front.max(r * cos_e.abs() + h * sin_e);
+            back = back.min(h * sin_e - r * cos_e.abs());
+        }
         let distance = match radius {
             Some(r) if r.is_finite() && r > 0.0 => r as f64,
             Some(r) => return Err(err(format!("orbit radius {r} must be finite and > 0"))),
-            None => sphere / half_min_fov(yfov_f, aspect).sin(),
+            None => needed.max(front + 1e-3) * scale,
         };
-        let (near, far) = depth_range(distance, sphere);
-        let elevation = (elevation_deg as f64).to_radians();
+        let model_depth = distance / scale;
+        let near = ((model_depth - front) * 0.5).max(model_depth * 1e-4) * scale;
+        let far = (model_depth - back) * 2.0 * scale;
         (0..n)
             .map(|k| {
                 let azimuth = std::f64::consts::TAU * k as f64 / n as f64;

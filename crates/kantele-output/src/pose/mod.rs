@@ -32,7 +32,7 @@
 //!
 //! Constructors: [`CameraPose::from_scene_camera`], [`CameraPose::look_at`],
 //! [`CameraPose::from_opencv`], [`CameraPose::from_opengl`], and in [`framing`] the automatic
-//! framing ([`CameraPose::frame_bounds`]) and orbits ([`CameraPose::orbit`]). The JSON sidecar
+//! framing ([`CameraPose::frame`]) and orbits ([`CameraPose::orbit`]). The JSON sidecar
 //! and the pose-list reader are in [`sidecar`].
 
 pub mod framing;
@@ -44,7 +44,7 @@ use kantele_rules::scene::{Camera, Scene};
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
-pub use framing::{Bounds, UpAxis};
+pub use framing::{Bounds, Silhouette, UpAxis};
 pub use sidecar::{read_views, Sidecar, ViewDefaults};
 
 /// A camera that cannot be built or read: the message says which value is wrong.

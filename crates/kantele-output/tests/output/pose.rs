@@ -5,7 +5,7 @@ use kantele::pipeline::{FnShader, Indices, RenderState, Renderer, RendererOption
 use kantele_output::pose::sidecar::{read_views, SidecarCamera, ViewDefaults};
 use kantele_output::pose::{
     eye_depth, intrinsics_of_projection, opencv_from_opengl, rows, Bounds, CameraPose, Intrinsics,
-    Projection, UpAxis,
+    Projection, Silhouette, UpAxis,
 };
 
 fn bits(m: &Mat4) -> Vec<u32> {
@@ -166,11 +166,11 @@ fn intrinsics_and_projection_round_trip() {
     assert_eq!(bits(&file.projection()), bits(&persp.projection()));
 }
 
-/// Fraction of the image the points span along their tighter direction (for a model as wide
-/// as tall, the shorter image side), and whether all are inside.
-fn fill(pose: &CameraPose, points: &[Vec3]) -> (f64, bool) {
+/// How points project: the fraction of the image they span along their tighter direction (for
+/// a model as wide as tall, the shorter image side), the middle of their extent in NDC, and
+/// whether all are inside.
+fn fill(pose: &CameraPose, points: &[Vec3]) -> (f64, Vec2, bool) {
     let clip_from_world = pose.projection() * pose.view();
-    let (w, h) = (pose.width as f64, pose.height as f64);
     let (mut lo, mut hi) = (Vec2::splat(f32::MAX), Vec2::splat(f32::MIN));
     let mut inside = true;
     for p in points {
@@ -182,8 +182,19 @@ fn fill(pose: &CameraPose, points: &[Vec3]) -> (f64, bool) {
         hi = hi.max(ndc);
     }
     let span = (hi - lo) / 2.0;
-    let _ = (w, h);
-    (span.max_element() as f64, inside)
+    (span.max_element() as f64, (hi + lo) / 2.0, inside)
+}
+
+/// How far from the picture's centre the points reach, in NDC (1 = the border).
+fn reach(pose: &CameraPose, points: &[Vec3]) -> f64 {
+    let clip_from_world = pose.projection() * pose.view();
+    points
+        .iter()
+        .map(|p| {
+            let c = clip_from_world * p.extend(1.0);
+            (c.x / c.w).abs().max((c.y / c.w).abs()) as f64
+        })
+        .fold(0.0, f64::max)
 }
 
 fn blob(scale: f32, offset: Vec3, size: Vec3) -> Vec<Vec3> {
@@ -219,17 +230,49 @@ fn framing_fills_the_picture_at_any_scale() {
                     Vec3::new(0.1, 2.0, 0.3),
                 ] {
                     let points = blob(scale, Vec3::new(3.0, -2.0, 7.0), size);
-                    let bounds = Bounds::from_points(points.iter().map(|p| p.as_dvec3())).unwrap();
-                    let pose = CameraPose::frame_bounds(&bounds, dir, up, 45f32.to_radians(), w, h)
-                        .unwrap();
-                    let (f, inside) = fill(&pose, &points);
-                    let case = format!("scale {scale} {w}x{h} from {dir} size {size}");
-                    assert!(inside, "{case}: a point is outside the picture");
-                    assert!(f >= 0.8, "{case}: fills {f:.3}");
+                    let silhouette =
+                        Silhouette::from_points(points.iter().map(|p| p.as_dvec3())).unwrap();
+                    let perspective =
+                        CameraPose::frame(&silhouette, dir, up, 45f32.to_radians(), w, h);
+                    let orthographic = CameraPose::frame_orthographic(&silhouette, dir, up, w, h);
+                    for pose in [perspective.unwrap(), orthographic.unwrap()] {
+                        let (f, middle, inside) = fill(&pose, &points);
+                        let case = format!("scale {scale} {w}x{h} from {dir} size {size}");
+                        assert!(inside, "{case}: a point is outside the picture");
+                        assert!((f - 0.92).abs() < 1e-3, "{case}: fills {f:.4}");
+                        assert!(middle.abs().max_element() < 1e-3, "{case}: at {middle}");
+                    }
                 }
             }
         }
     }
+}
+
+/// A model much smaller than its box from the camera's side (a ring) fills the picture by its
+/// own outline, not by its box's.
+#[test]
+fn framing_follows_the_silhouette_not_the_box() {
+    let ring: Vec<Vec3> = (0..720)
+        .map(|i| {
+            let a = i as f32 / 720.0 * std::f32::consts::TAU;
+            Vec3::new(a.cos() * 2.0, 0.5, a.sin() * 2.0)
+        })
+        .chain([Vec3::new(0.0, -0.5, 0.0)])
+        .collect();
+    let silhouette = Silhouette::from_points(ring.iter().map(|p| p.as_dvec3())).unwrap();
+    let boxed = Silhouette::of_bounds(silhouette.bounds());
+    let dir = Vec3::new(0.5, 0.6, 1.0);
+    let yfov = 45f32.to_radians();
+    let tight = CameraPose::frame(&silhouette, dir, UpAxis::Y, yfov, 512, 512).unwrap();
+    let loose = CameraPose::frame(&boxed, dir, UpAxis::Y, yfov, 512, 512).unwrap();
+    let (f_tight, middle, inside) = fill(&tight, &ring);
+    let (f_loose, _, _) = fill(&loose, &ring);
+    assert!(inside && (f_tight - 0.92).abs() < 1e-3, "{f_tight}");
+    assert!(middle.abs().max_element() < 1e-3, "{middle}");
+    assert!(
+        f_loose < f_tight - 0.05,
+        "box {f_loose}, silhouette {f_tight}"
+    );
 }
 
 #[test]
@@ -239,8 +282,10 @@ fn orbit_cameras_all_look_at_the_centre() {
             min: DVec3::new(-1.0, 0.0, -2.0) * scale,
             max: DVec3::new(3.0, 1.0, 0.0) * scale,
         };
+        let silhouette = Silhouette::of_bounds(&bounds);
         let center = bounds.center().as_vec3();
-        let poses = CameraPose::orbit(&bounds, 8, 20.0, None, UpAxis::Y, 0.8, 320, 240).unwrap();
+        let poses =
+            CameraPose::orbit(&silhouette, 8, 20.0, None, UpAxis::Y, 0.8, 320, 240).unwrap();
         assert_eq!(poses.len(), 8);
         let d0 = (poses[0].eye().as_dvec3() - bounds.center()).length();
         for pose in &poses {
@@ -253,7 +298,7 @@ fn orbit_cameras_all_look_at_the_centre() {
             assert!((d - d0).abs() <= d0 * 1e-5 && (z - d0).abs() <= d0 * 1e-5);
             let elevation = ((pose.eye().as_dvec3().y - bounds.center().y) / d).asin();
             assert!((elevation.to_degrees() - 20.0).abs() < 1e-3);
-            let (f, inside) = fill(pose, &bounds.corners().map(|c| c.as_vec3()));
+            let (f, _, inside) = fill(pose, &bounds.corners().map(|c| c.as_vec3()));
             assert!(inside && f > 0.3, "{f}");
         }
         // Azimuth 90° with Y up is +X.
@@ -261,7 +306,7 @@ fn orbit_cameras_all_look_at_the_centre() {
             poses[2].eye().x > center.x && (poses[2].eye().z - center.z).abs() < d0 as f32 * 1e-3
         );
         let given = CameraPose::orbit(
-            &bounds,
+            &silhouette,
             3,
             0.0,
             Some(10.0 * scale as f32),
@@ -277,12 +322,34 @@ fn orbit_cameras_all_look_at_the_centre() {
         );
         assert!(given[0].eye().y < center.y, "Z up: azimuth 0 looks from -Y");
     }
-    let unit = Bounds {
+    let unit = Silhouette::of_bounds(&Bounds {
         min: DVec3::ZERO,
         max: DVec3::ONE,
-    };
+    });
     assert!(CameraPose::orbit(&unit, 0, 20.0, None, UpAxis::Y, 0.8, 32, 32).is_err());
     assert!(CameraPose::orbit(&unit, 4, 20.0, Some(-1.0), UpAxis::Y, 0.8, 32, 32).is_err());
+}
+
+/// A turntable's one distance keeps the model inside at every azimuth and is tight: at its
+/// worst azimuth the model fills the picture's tighter direction.
+#[test]
+fn orbit_distance_fits_every_azimuth_tightly() {
+    for (up, elevation, size, (w, h)) in [
+        (UpAxis::Y, 20.0, Vec3::new(1.0, 0.5, 0.2), (512u32, 512u32)),
+        (UpAxis::Z, -35.0, Vec3::new(0.3, 2.0, 0.6), (640, 360)),
+        (UpAxis::Y, 70.0, Vec3::new(2.0, 0.1, 0.4), (300, 500)),
+    ] {
+        let points = blob(1.0, Vec3::new(0.4, -1.0, 2.0), size);
+        let silhouette = Silhouette::from_points(points.iter().map(|p| p.as_dvec3())).unwrap();
+        let poses = CameraPose::orbit(&silhouette, 720, elevation, None, up, 0.8, w, h).unwrap();
+        let mut fullest = 0.0f64;
+        for pose in &poses {
+            let (_, _, inside) = fill(pose, &points);
+            assert!(inside, "{up:?} {elevation}: a point is outside");
+            fullest = fullest.max(reach(pose, &points));
+        }
+        assert!(fullest > 0.91, "{up:?} {elevation}: at most {fullest:.4}");
+    }
 }
 
 #[test]
@@ -396,7 +463,19 @@ fn sidecar_round_trip_is_bit_identical() {
         min: DVec3::splat(-0.37),
         max: DVec3::new(1.1, 0.9, 0.77),
     };
-    poses.extend(CameraPose::orbit(&bounds, 13, 23.0, None, UpAxis::Z, 0.61, 333, 222).unwrap());
+    poses.extend(
+        CameraPose::orbit(
+            &Silhouette::of_bounds(&bounds),
+            13,
+            23.0,
+            None,
+            UpAxis::Z,
+            0.61,
+            333,
+            222,
+        )
+        .unwrap(),
+    );
     let texts: Vec<String> = poses.iter().map(sidecar_json).collect();
     let list = format!("[{}]", texts.join(","));
     let back = read_views(&list, &ViewDefaults::default()).unwrap();
