@@ -382,6 +382,10 @@ pub struct RenderArgs {
     /// Print one JSON line per finished image on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Print nothing on success: no `wrote` line per image on stderr and no count of images
+    /// skipped by --skip-existing (warnings and errors still print).
+    #[arg(long, short)]
+    pub quiet: bool,
     /// Frames per second of an animated -o (.gif, .apng) and time steps per second of
     /// --time-range.
     #[arg(long, value_name = "N", default_value_t = 24, value_parser = clap::value_parser!(u16).range(1..=100))]

@@ -66,9 +66,22 @@ fn run_view(_: cli::ViewArgs) -> anyhow::Result<()> {
     anyhow::bail!("view: this kantele was built without the window viewer (cargo install --locked --path crates/kantele-cli --features viewer)")
 }
 
+/// The help that explains a usage error: the subcommand's, when the arguments name one.
+fn help_command(args: impl IntoIterator<Item = String>) -> String {
+    let command = <Cli as clap::CommandFactory>::command();
+    args.into_iter()
+        .skip(1)
+        .find(|a| !a.starts_with('-'))
+        .filter(|a| command.find_subcommand(a).is_some())
+        .map_or_else(
+            || "kantele --help".to_string(),
+            |sub| format!("kantele {sub} --help"),
+        )
+}
+
 /// clap's usage error as one line: the problem, what is missing, and its tips ("a similar
-/// argument exists"), without the usage block.
-fn usage_error_line(text: &str) -> String {
+/// argument exists"), without the usage block; `help` names the help to read.
+fn usage_error_line(text: &str, help: &str) -> String {
     let mut parts: Vec<String> = Vec::new();
     for line in text.lines() {
         let line = line.trim();
@@ -88,7 +101,7 @@ fn usage_error_line(text: &str) -> String {
         message.push_str(sep);
         message.push_str(p);
     }
-    format!("{} (see kantele --help)", one_line(&message))
+    format!("{} (see {help})", one_line(&message))
 }
 
 /// Reports `KANTELE_ISA`, which the renderer reads without complaint: a value that names no
@@ -113,7 +126,11 @@ fn main() -> ExitCode {
             return ExitCode::from(EXIT_ERROR);
         }
         Err(e) => {
-            eprintln!("kantele: error: {}", usage_error_line(&e.to_string()));
+            let help = help_command(std::env::args());
+            eprintln!(
+                "kantele: error: {}",
+                usage_error_line(&e.to_string(), &help)
+            );
             return ExitCode::from(EXIT_ERROR);
         }
     };
@@ -149,7 +166,21 @@ mod tests {
     use clap::Parser;
 
     fn error_of(args: &[&str]) -> String {
-        usage_error_line(&Cli::try_parse_from(args).unwrap_err().to_string())
+        let help = help_command(args.iter().map(|a| a.to_string()));
+        usage_error_line(&Cli::try_parse_from(args).unwrap_err().to_string(), &help)
+    }
+
+    #[test]
+    fn usage_errors_point_to_the_subcommand_help() {
+        let render = error_of(&["kantele", "render", "--bogus"]);
+        assert!(render.ends_with("(see kantele render --help)"), "{render}");
+        let thumbnail = error_of(&["kantele", "--size", "thumbnail", "a"]);
+        assert!(
+            thumbnail.ends_with("(see kantele thumbnail --help)"),
+            "{thumbnail}"
+        );
+        let unknown = error_of(&["kantele", "rendr"]);
+        assert!(unknown.ends_with("(see kantele --help)"), "{unknown}");
     }
 
     #[test]

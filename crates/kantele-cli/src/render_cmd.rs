@@ -557,13 +557,14 @@ pub fn run(args: &RenderArgs) -> Result<()> {
     // Ctrl-C and SIGTERM cancel the frame in flight, not only the next one.
     backend.set_cancel_flag(Some(interrupt.flag()));
     let progress = progress_bar(total);
+    let mut report = Report::new(args, &progress);
     let mut warnings = Warnings::default();
 
     for (input, outs) in inputs.iter().zip(&plan) {
         interrupt.check()?;
         let done = |paths: &FramePaths| paths.color.is_some() && paths.all().all(|p| p.exists());
         if args.skip_existing && outs.iter().all(done) {
-            progress.inc(outs.len() as u64);
+            report.skip(outs.len() as u64, outs.len() as u64);
             continue;
         }
         let label = input.label();
@@ -595,7 +596,7 @@ pub fn run(args: &RenderArgs) -> Result<()> {
                 bail!("an animation cannot go to standard output");
             };
             if args.skip_existing && path.exists() {
-                progress.inc(frames as u64);
+                report.skip(1, frames as u64);
                 continue;
             }
             let mut animation = Animation::new(width, height, args.fps);
@@ -648,11 +649,16 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             }
             interrupt.check()?;
             set.commit()?;
+            let written = FramePaths {
+                sidecar: outs[0].sidecar.clone(),
+                ..frame_paths
+            };
+            report.wrote(&written, width, height);
             continue;
         }
         for (time, outs) in steps.iter().zip(outs.chunks(views)) {
             if args.skip_existing && outs.iter().all(done) {
-                progress.inc(outs.len() as u64);
+                report.skip(outs.len() as u64, outs.len() as u64);
                 continue;
             }
             job.pose_at(*time, player.as_ref())?;
@@ -662,10 +668,11 @@ pub fn run(args: &RenderArgs) -> Result<()> {
             for (pose, paths) in poses.iter().zip(outs) {
                 interrupt.check()?;
                 if args.skip_existing && done(paths) {
-                    progress.inc(1);
+                    report.skip(1, 1);
                     continue;
                 }
                 let ms = job.render_view(backend.as_mut(), pose, paths, &interrupt)?;
+                report.wrote(paths, pose.width, pose.height);
                 if args.json {
                     let mut line = json!({
                         "scene": input.stem(),
@@ -684,7 +691,56 @@ pub fn run(args: &RenderArgs) -> Result<()> {
         }
     }
     progress.finish_and_clear();
+    report.finish();
     Ok(())
+}
+
+/// What `render` tells the user on stderr as it goes: a `wrote` line per image and, at the end,
+/// how many images `--skip-existing` skipped; nothing with `--quiet`.
+struct Report<'a> {
+    quiet: bool,
+    progress: &'a ProgressBar,
+    skipped: u64,
+}
+
+impl<'a> Report<'a> {
+    fn new(args: &RenderArgs, progress: &'a ProgressBar) -> Self {
+        Self {
+            quiet: args.quiet,
+            progress,
+            skipped: 0,
+        }
+    }
+
+    /// One image written: its files (standard output for `-o -`).
+    fn wrote(&self, files: &FramePaths, width: u32, height: u32) {
+        if self.quiet {
+            return;
+        }
+        let mut names: Vec<String> = files.all().map(|p| p.display().to_string()).collect();
+        if files.color.is_none() {
+            names.insert(0, "standard output".into());
+        }
+        self.progress.suspend(|| {
+            eprintln!("kantele: wrote {} ({width}x{height})", names.join(", "));
+        });
+    }
+
+    /// `images` skipped because their files exist: `frames` steps of the progress bar (an
+    /// animation is one image of many frames).
+    fn skip(&mut self, images: u64, frames: u64) {
+        self.skipped += images;
+        self.progress.inc(frames);
+    }
+
+    fn finish(&self) {
+        if self.skipped > 0 && !self.quiet {
+            eprintln!(
+                "kantele: skipped {} image(s) whose files exist (--skip-existing)",
+                self.skipped
+            );
+        }
+    }
 }
 
 impl SceneJob<'_> {

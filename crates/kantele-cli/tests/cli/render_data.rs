@@ -579,7 +579,20 @@ fn folders_patterns_and_skip_existing() {
         a.extend_from_slice(extra);
         kantele(&a)
     };
-    ok(&render(&dir.s("in"), &[]));
+    let first = render(&dir.s("in"), &[]);
+    ok(&first);
+    // One line per image written, naming its files.
+    let said = crate::common::stderr(&first);
+    let wrote: Vec<&str> = said
+        .lines()
+        .filter(|l| l.starts_with("kantele: wrote "))
+        .collect();
+    assert_eq!(wrote.len(), 2, "{said}");
+    let (a_png, a_json) = (dir.s("out/a.png"), dir.s("out/a.png.json"));
+    assert!(
+        wrote[0] == format!("kantele: wrote {a_png}, {a_json} (16x16)"),
+        "{said}"
+    );
     let listing = |d: &TempDir| {
         let mut v: Vec<String> = std::fs::read_dir(d.path("out"))
             .unwrap()
@@ -599,7 +612,20 @@ fn folders_patterns_and_skip_existing() {
         .modified()
         .unwrap();
     std::thread::sleep(Duration::from_millis(20));
-    ok(&render(&dir.s("in/*.obj"), &["--skip-existing"]));
+    let resumed = render(&dir.s("in/*.obj"), &["--skip-existing"]);
+    ok(&resumed);
+    let said = crate::common::stderr(&resumed);
+    assert!(
+        said.contains("kantele: wrote ") && said.contains("b.png.json"),
+        "{said}"
+    );
+    assert!(
+        said.contains("kantele: skipped 1 image(s) whose files exist"),
+        "{said}"
+    );
+    let quiet = render(&dir.s("in/*.obj"), &["--skip-existing", "--quiet"]);
+    ok(&quiet);
+    assert_eq!(crate::common::stderr(&quiet), "", "--quiet prints nothing");
     let after = std::fs::metadata(dir.path("out/a.png"))
         .unwrap()
         .modified()
