@@ -14,11 +14,6 @@ use pyo3::types::PyDict;
 
 use crate::errors::value_error;
 
-/// Elevation of orbit cameras above the scene's equator, degrees (as `kantele render --orbit`).
-pub const ORBIT_ELEVATION_DEG: f32 = 20.0;
-/// Vertical field of view of orbit and framing cameras, degrees (as `kantele render --orbit`).
-pub const ORBIT_YFOV_DEG: f32 = 45.0;
-
 /// A camera: where it is, how it projects, its depth range and, when it has one, its image size.
 ///
 /// Conventions (`kantele_output::pose`): the OpenGL camera frame looks down −Z with y up; the OpenCV
@@ -176,7 +171,11 @@ impl PyCamera {
     /// / `zfar` are given. `size` ties the camera to an image size (the default size of
     /// `render`).
     #[staticmethod]
-    #[pyo3(signature = (eye, target, up = [0.0, 1.0, 0.0], yfov = 0.8, size = None, znear = None, zfar = None))]
+    // The text signature spells the array default as Python does, so that `help()` shows it.
+    #[pyo3(
+        signature = (eye, target, up = [0.0, 1.0, 0.0], yfov = 0.8, size = None, znear = None, zfar = None),
+        text_signature = "(eye, target, up=(0.0, 1.0, 0.0), yfov=0.8, size=None, znear=None, zfar=None)"
+    )]
     fn look_at(
         eye: [f64; 3],
         target: [f64; 3],
@@ -245,6 +244,10 @@ impl PyCamera {
     #[staticmethod]
     #[pyo3(signature = (path, size = None))]
     fn read_views(path: std::path::PathBuf, size: Option<(i64, i64)>) -> PyResult<Vec<Self>> {
+        // Missing or unreadable files raise what `kantele.load` raises for them.
+        if let Err(e) = std::fs::metadata(&path) {
+            return Err(crate::errors::io_error(&path, e));
+        }
         let defaults = pose::ViewDefaults {
             size: size_arg(size)?,
             ..Default::default()

@@ -1,6 +1,8 @@
 //! Library errors as Python exceptions, with the library's one-line messages.
 
-use pyo3::exceptions::{PyFileNotFoundError, PyOSError, PyRuntimeError, PyValueError};
+use pyo3::exceptions::{
+    PyFileNotFoundError, PyOSError, PyPermissionError, PyRuntimeError, PyValueError,
+};
 use pyo3::PyErr;
 
 use kantele::error::RenderError;
@@ -16,6 +18,17 @@ pub fn load_error(error: LoadError) -> PyErr {
         }
         LoadError::Io { .. } => PyOSError::new_err(message),
         _ => PyValueError::new_err(message),
+    }
+}
+
+/// An error reading `path`: `FileNotFoundError` when it is missing, `PermissionError` when it may
+/// not be read, else `OSError`, with the one-line message `PATH: problem`.
+pub fn io_error(path: &std::path::Path, error: std::io::Error) -> PyErr {
+    let message = format!("{}: {error}", path.display());
+    match error.kind() {
+        std::io::ErrorKind::NotFound => PyFileNotFoundError::new_err(message),
+        std::io::ErrorKind::PermissionDenied => PyPermissionError::new_err(message),
+        _ => PyOSError::new_err(message),
     }
 }
 

@@ -16,7 +16,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::arrays::view_dict;
-use crate::camera::{self, pose_error, PyCamera, ORBIT_ELEVATION_DEG, ORBIT_YFOV_DEG};
+use crate::camera::{self, pose_error, PyCamera};
 use crate::errors::{load_error, render_error, value_error};
 use crate::mesh_arrays::{scene_from_arrays, MeshArrays};
 use crate::render::{render_views, OutputKind, RenderedView};
@@ -526,8 +526,9 @@ impl PyScene {
 
     /// `views` cameras circling the scene at `elevation` degrees above its centre, each
     /// framing all of it for images of `size` (default: the scene's resolution) with a vertical
-    /// field of view of `yfov_deg`: the cameras of `kantele render --orbit VIEWS`.
-    #[pyo3(signature = (views, size = None, elevation = ORBIT_ELEVATION_DEG, yfov_deg = ORBIT_YFOV_DEG))]
+    /// field of view of `yfov_deg`: the cameras of `kantele render --orbit VIEWS` (whose
+    /// defaults these are; written as literals so that `help()` shows them).
+    #[pyo3(signature = (views, size = None, elevation = 20.0, yfov_deg = 45.0))]
     fn orbit_cameras(
         &self,
         views: u32,
@@ -543,7 +544,10 @@ impl PyScene {
 
     /// A camera framing everything the scene draws, seen from `direction` (a vector from the
     /// scene towards the camera), for images of `size` (default: the scene's resolution).
-    #[pyo3(signature = (direction = [0.4, 0.5, 1.0], size = None, yfov_deg = ORBIT_YFOV_DEG))]
+    #[pyo3(
+        signature = (direction = [0.4, 0.5, 1.0], size = None, yfov_deg = 45.0),
+        text_signature = "($self, direction=(0.4, 0.5, 1.0), size=None, yfov_deg=45.0)"
+    )]
     fn framing_camera(
         &self,
         direction: [f32; 3],

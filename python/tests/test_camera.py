@@ -1,6 +1,7 @@
 """Cameras: OpenCV intrinsics and matrices land points where the pinhole model says, look-at and
 orbit helpers, and the sidecar-style dict reads back as the same camera."""
 
+import inspect
 import json
 
 import numpy as np
@@ -114,3 +115,22 @@ def test_look_at_depth_range_and_camera_size():
     sized = kantele.Camera.look_at((0, 0, 10), (0, 0, 0), size=(30, 20))
     out = kantele.Scene.builtin("cube").render(camera=sized, outputs=("depth",))
     assert out["depth"].shape == (20, 30)
+
+
+def test_read_views_of_a_missing_file_is_file_not_found(tmp_path):
+    path = tmp_path / "nope.json"
+    with pytest.raises(FileNotFoundError) as e:
+        kantele.Camera.read_views(path)
+    assert str(path) in str(e.value) and "\n" not in str(e.value)
+
+
+def test_a_pose_without_znear_gets_from_opencvs_default(tmp_path):
+    """`--views` and `Camera.read_views` read a pose record without `znear` with the near plane
+    `Camera.from_opencv` defaults to."""
+    record = {"world_to_camera": np.eye(4).tolist(), "convention": "opencv",
+              "fx": 100.0, "fy": 100.0, "cx": 31.5, "cy": 23.5, "width": 64, "height": 48}
+    path = tmp_path / "views.json"
+    path.write_text(json.dumps({"views": [record]}))
+    (camera,) = kantele.Camera.read_views(path)
+    default = inspect.signature(kantele.Camera.from_opencv).parameters["znear"].default
+    assert camera.znear == pytest.approx(default) and default == 0.01

@@ -524,9 +524,15 @@ const RENDER_HELP: &str = r#"Output templates:
 
 Cameras:
   --camera look-at:0,1,5:0,0,0[:0,1,0]   eye, target and up as x,y,z
-  --views FILE   a sidecar (OUT.json) or {"views": [{"world_to_camera": 4x4 rows,
-                 "convention": "opencv"|"opengl", "fx","fy","cx","cy" or "yfov",
-                 "width","height"}, ...]}; one image per view ({frame}).
+  --views FILE   a sidecar (OUT.json, which reproduces its picture), a list of sidecars, or
+                 pose records, one or a list or {"views": [...]}; one image per view ({frame}).
+                 A pose record has
+                   "world_to_camera": 4x4 rows with "convention": "opencv"|"opengl"
+                     (or "world_to_camera_opencv" / "world_to_camera_gl" instead);
+                   one projection: "fx","fy","cx","cy" (pixels; the top-left pixel's centre
+                     is 0,0), or "yfov" (radians), or "yfov_deg", or orthographic "ymag";
+                   optionally "width","height" (default: --size), "znear" (default 0.01,
+                     as Python's Camera.from_opencv) and "zfar" (default: infinite).
   Pixels stay square: the image's aspect decides the field of view across; without --size the
   image takes the file camera's aspect ratio.
 

@@ -359,7 +359,6 @@ fn sidecar(args: &RenderArgs, s: &SidecarInputs<'_>) -> Sidecar {
             },
         }),
         ids: SidecarIds {
-            file: None,
             channels: ID_FILES.into(),
             files: s
                 .paths

@@ -89,3 +89,9 @@ pub use kantele_rules::reference;
 #[doc(hidden)]
 pub use kantele_cpu::fuzz_targets;
 pub use kantele_cpu::{band, cpu, material, pbr_material, pipeline, raster, rop};
+
+/// The README's Rust example, compiled and run as a doctest (`cargo test --doc -p kantele`):
+/// the README's other code blocks run in `python/tests/test_readme.py`.
+#[cfg(doctest)]
+#[doc = include_str!("../../../README.md")]
+pub struct ReadmeDoctests;

@@ -38,6 +38,13 @@ fn render_builtin_cube() {
     }
     assert_eq!(side["backend"], "cpu");
     assert_eq!(side["world_to_camera_opencv"].as_array().unwrap().len(), 4);
+    // The id entry names only what exists: no `files` without id outputs, no `file: null`.
+    let ids = side["ids"].as_object().unwrap();
+    assert!(
+        ids.contains_key("channels") && !ids.contains_key("file"),
+        "{side}"
+    );
+    assert!(!ids.contains_key("files"), "{side}");
     assert_eq!(dir.files(), vec!["cube.png", "cube.png.json"]);
 }
 

@@ -8,7 +8,9 @@
 //! - the projection: intrinsics `"fx"`, `"fy"`, `"cx"`, `"cy"` (pixels, top-left pixel centre at
 //!   (0, 0)), or a vertical field of view `"yfov"` (radians) or `"yfov_deg"`, or an orthographic
 //!   `"ymag"`;
-//! - optionally `"width"`, `"height"`, `"znear"`, `"zfar"` (else the [`ViewDefaults`]).
+//! - optionally `"width"`, `"height"` (else the [`ViewDefaults`]' size), `"znear"` (else the
+//!   defaults', else [`DEFAULT_ZNEAR`], as Python's `Camera.from_opencv`) and `"zfar"` (else the
+//!   defaults', else infinite).
 //!
 //! A file is one record, a list of records, or `{"views": [records]}`. A sidecar is read
 //! through its `camera` and `world_to_camera_gl`, so it reproduces the projection and view
@@ -23,6 +25,10 @@ use serde_json::Value;
 use super::{
     err, from_rows, opencv_from_opengl, rows, CameraPose, Intrinsics, PoseError, Projection,
 };
+
+/// Near plane of a pose record that gives none, scene units (Python's `Camera.from_opencv` and
+/// `Camera.from_opengl` default to it too).
+pub const DEFAULT_ZNEAR: f32 = 0.01;
 
 /// What [`SidecarCamera::pixel_centers`] says.
 pub const PIXEL_CENTERS: &str =
@@ -200,11 +206,10 @@ pub struct SidecarNormals {
     pub encoding: String,
 }
 
-/// A sidecar's id entry: the file and the meaning of every id.
+/// A sidecar's id entry: the id files and the meaning of every id. (Sidecars written before the
+/// one-channel files had a `file` entry, always `null`; it is ignored when read.)
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct SidecarIds {
-    /// The id file, if written.
-    pub file: Option<String>,
     /// What each channel holds ([`ID_CHANNELS`]).
     pub channels: String,
     /// One-channel id files by kind (`instance`, `mesh`, `material`, `primitive` = a glTF mesh
@@ -429,10 +434,7 @@ impl PoseRecord {
                 ))
             }
         };
-        let znear = self
-            .znear
-            .or(defaults.znear)
-            .ok_or_else(|| err("the pose needs znear"))?;
+        let znear = self.znear.or(defaults.znear).unwrap_or(DEFAULT_ZNEAR);
         let zfar = self.zfar.or(defaults.zfar);
         CameraPose::new(width, height, projection, znear, zfar, world_to_camera_gl)
     }
