@@ -52,3 +52,32 @@ def cli() -> str:
         skip_or_fail("cli", "no kantele binary in target/ and no cargo to build one")
     subprocess.run(["cargo", "build", "-p", "kantele-cli"], cwd=REPO, check=True)
     return str(target / "debug" / "kantele")
+
+
+def _skip_reason(report) -> str:
+    longrepr = report.longrepr
+    reason = longrepr[2] if isinstance(longrepr, tuple) else str(longrepr)
+    return " ".join(reason.removeprefix("Skipped: ").split())
+
+
+def pytest_runtest_logreport(report):
+    """Appends each skip to `$KANTELE_SKIP_LOG` (as the Rust tests' `kantele_testkit::skip`
+    does), so that `.ci/test` sums up Rust and Python skips in one line."""
+    log = os.environ.get("KANTELE_SKIP_LOG")
+    if report.skipped and log:
+        with open(log, "a", encoding="utf-8") as f:
+            f.write(f"skipping {report.nodeid}: {_skip_reason(report)}\n")
+
+
+def pytest_terminal_summary(terminalreporter):
+    """Ends every run with one line: what was skipped and why, or that nothing was."""
+    skipped = terminalreporter.stats.get("skipped", [])
+    if not skipped:
+        terminalreporter.write_line("kantele: no Python test skipped")
+        return
+    reasons = {}
+    for report in skipped:
+        reason = _skip_reason(report)
+        reasons[reason] = reasons.get(reason, 0) + 1
+    listed = "; ".join(f"{why} ({n})" for why, n in sorted(reasons.items()))
+    terminalreporter.write_line(f"kantele: {len(skipped)} Python test(s) skipped: {listed}")

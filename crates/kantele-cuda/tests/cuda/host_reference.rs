@@ -65,7 +65,7 @@ fn compile_harness() -> Result<Option<PathBuf>, String> {
         )),
         Err(e) if required() => Err(format!("KANTELE_REQUIRE=cxx but {cxx} cannot run: {e}")),
         Err(e) => {
-            eprintln!("skipping: no C++ compiler ({cxx}: {e})");
+            kantele_testkit::report_skip(format!("no C++ compiler ({cxx}: {e})"));
             Ok(None)
         }
     }

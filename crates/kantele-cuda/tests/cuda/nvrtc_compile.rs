@@ -20,7 +20,7 @@ fn nvrtc() -> Option<Nvrtc> {
         Ok(n) => Some(n),
         Err(e) if required() => panic!("KANTELE_REQUIRE=nvrtc but {e}"),
         Err(e) => {
-            eprintln!("skipping: {e}");
+            kantele_testkit::report_skip(e);
             None
         }
     }
