@@ -48,6 +48,10 @@ def load(
 def write_png(path: PathLike, image: npt.NDArray[np.uint8]) -> None:
     """Writes a `uint8` (H, W, 4) or (H, W, 3) image, row 0 at the top, as PNG."""
 
+def _run_cli(args: List[str]) -> int:
+    """Runs the `kantele` command on `args` (its name first) and returns its exit status; the
+    package's `kantele` console script and `python -m kantele` call it."""
+
 def isa() -> str:
     """The instruction set the CPU renderer uses in this process (`avx512`, `avx2`, `sse41`,
     `sse2`, `neon` or `scalar`): the best this CPU has, or the one `KANTELE_ISA` names. A

@@ -59,6 +59,13 @@ fn isa() -> &'static str {
     Isa::selected().name()
 }
 
+/// Runs the `kantele` command on `args` (its name first) and returns its exit status, with the
+/// GIL released: the package's `kantele` console script (`kantele/_cli.py`) is this call.
+#[pyfunction]
+fn _run_cli(py: Python<'_>, args: Vec<std::ffi::OsString>) -> u8 {
+    py.detach(|| kantele_cli::run_command_line(args))
+}
+
 /// Warns (`RuntimeWarning`, once, at import) when `KANTELE_ISA` names no instruction set or one
 /// this CPU lacks; renders then use the best level, as the `kantele` command does.
 fn warn_about_isa_env(py: Python<'_>) -> PyResult<()> {
@@ -82,6 +89,7 @@ fn _kantele(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(files::write_png, m)?)?;
     m.add_function(wrap_pyfunction!(isa, m)?)?;
+    m.add_function(wrap_pyfunction!(_run_cli, m)?)?;
     m.add("MAX_SIZE", kantele::MAX_TARGET_SIZE)?;
     m.add(
         "OUTPUTS",

@@ -27,6 +27,7 @@ NOT_RUN_HERE = {
     "cargo build --release -p kantele-cli --features cuda": "needs a CUDA build; CI builds the "
     "feature and the GPU check runs on a GPU machine",
     "pip install": "CI's .ci/test installs the package the same way before these tests",
+    "pip wheel": "CI's .ci/test builds the same wheel when it installs the package",
     "cargo +nightly fuzz": "needs a nightly toolchain; .ci/run fuzzes where one is installed",
     "kantele view": "opens a window until it is closed; crates/kantele-cli/tests/cli/view.rs "
     "drives the viewer",
