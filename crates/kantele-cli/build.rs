@@ -15,7 +15,12 @@ fn main() {
     } else {
         ""
     };
-    println!("cargo:rustc-env=KANTELE_BUILD=opt-level {opt_level}{pgo}");
+    let lean = if std::env::var_os("CARGO_FEATURE_LEAN_KERNELS").is_some() {
+        ", lean kernels"
+    } else {
+        ""
+    };
+    println!("cargo:rustc-env=KANTELE_BUILD=opt-level {opt_level}{pgo}{lean}");
     println!("cargo:rerun-if-env-changed=CARGO_ENCODED_RUSTFLAGS");
     println!("cargo:rerun-if-changed=build.rs");
 }

@@ -102,7 +102,7 @@ def test_the_shell_blocks_run(readme_folder):
             not_run.append(f"README.md:{line} {command.split('#')[0].strip()}: {reason}")
             continue
         program = command.split()[0]
-        if command.startswith("cargo run --release -p kantele-cli -- "):
+        if command.startswith("cargo run ") and " -p kantele-cli " in command:
             # The first picture: the command line cargo runs, with the binary the tests built.
             command = "kantele " + command.split(" -- ", 1)[1]
         elif command.startswith("python -m kantele.ray"):
