@@ -125,6 +125,50 @@ fn pattern_scenes(pattern: &str) -> Result<Vec<PathBuf>> {
     Ok(found)
 }
 
+/// The loader's options from the command's load flags.
+fn load_options(args: &LoadArgs) -> Result<LoadOptions> {
+    Ok(LoadOptions {
+        max_memory: args.max_memory.unwrap_or(kantele_scene::DEFAULT_MAX_MEMORY),
+        allow_read: args.allow_read.clone(),
+        strict: args.strict,
+        shading: match args.shading {
+            ShadingArg::Auto => None,
+            ShadingArg::Lambert => Some(Shading::Lambert),
+            ShadingArg::Pbr => Some(Shading::Pbr),
+        },
+        environment: match args.environment.as_deref() {
+            None => EnvironmentChoice::Default,
+            Some("studio") => EnvironmentChoice::Studio,
+            Some("none") => EnvironmentChoice::None,
+            Some(file) => {
+                let path = PathBuf::from(file);
+                if !path.is_file() {
+                    bail!("--environment {file}: no such file (or use studio, none)");
+                }
+                EnvironmentChoice::File(path)
+            }
+        },
+        environment_intensity: args.environment_intensity,
+        environment_rotation_degrees: args.environment_rotation,
+        exposure: args.exposure,
+        tonemap: match args.tonemap {
+            TonemapArg::None => Tonemap::None,
+            TonemapArg::PbrNeutral => Tonemap::PbrNeutral,
+            TonemapArg::Aces => Tonemap::Aces,
+        },
+        scene: args.choice.scene.as_deref().map(parse_choice),
+        variant: args.choice.variant.clone(),
+        animation: args.choice.animation.as_deref().map(parse_choice),
+        time: args.choice.time.unwrap_or(0.0),
+        cull: args.choice.cull.map(|c| match c {
+            CullArg::Back => CullMode::Back,
+            CullArg::Front => CullMode::Front,
+            CullArg::None => CullMode::None,
+        }),
+        ..LoadOptions::default()
+    })
+}
+
 /// The inputs of a command, files first: a folder stands for the scene files in it and a
 /// pattern (`*`, `?`, `[...]`) for the scene files it matches. Checks that files exist and
 /// built-ins are known before anything is rendered.
@@ -184,48 +228,4 @@ impl Warnings {
             }
         }
     }
-}
-
-/// The loader's options from the command's load flags.
-fn load_options(args: &LoadArgs) -> Result<LoadOptions> {
-    Ok(LoadOptions {
-        max_memory: args.max_memory.unwrap_or(kantele_scene::DEFAULT_MAX_MEMORY),
-        allow_read: args.allow_read.clone(),
-        strict: args.strict,
-        shading: match args.shading {
-            ShadingArg::Auto => None,
-            ShadingArg::Lambert => Some(Shading::Lambert),
-            ShadingArg::Pbr => Some(Shading::Pbr),
-        },
-        environment: match args.environment.as_deref() {
-            None => EnvironmentChoice::Default,
-            Some("studio") => EnvironmentChoice::Studio,
-            Some("none") => EnvironmentChoice::None,
-            Some(file) => {
-                let path = PathBuf::from(file);
-                if !path.is_file() {
-                    bail!("--environment {file}: no such file (or use studio, none)");
-                }
-                EnvironmentChoice::File(path)
-            }
-        },
-        environment_intensity: args.environment_intensity,
-        environment_rotation_degrees: args.environment_rotation,
-        exposure: args.exposure,
-        tonemap: match args.tonemap {
-            TonemapArg::None => Tonemap::None,
-            TonemapArg::PbrNeutral => Tonemap::PbrNeutral,
-            TonemapArg::Aces => Tonemap::Aces,
-        },
-        scene: args.choice.scene.as_deref().map(parse_choice),
-        variant: args.choice.variant.clone(),
-        animation: args.choice.animation.as_deref().map(parse_choice),
-        time: args.choice.time.unwrap_or(0.0),
-        cull: args.choice.cull.map(|c| match c {
-            CullArg::Back => CullMode::Back,
-            CullArg::Front => CullMode::Front,
-            CullArg::None => CullMode::None,
-        }),
-        ..LoadOptions::default()
-    })
 }

@@ -7,7 +7,7 @@
 use std::str::FromStr;
 
 use glam::{DVec3, Vec3};
-use kantele_rules::scene::{Mesh, Scene};
+use kantele_rules::scene::{Draw, Mesh, Scene};
 
 use super::{err, look_at_f64, unit, CameraPose, PoseError, Projection};
 
@@ -86,21 +86,12 @@ impl Bounds {
     /// World-space box of everything the scene draws (mesh boxes through their transforms);
     /// `None` when nothing finite is drawn.
     pub fn of_scene(scene: &Scene) -> Option<Self> {
-        let corners = scene.draws.iter().flat_map(|draw| {
-            let model = draw.model.as_dmat4();
-            let bounds = scene.meshes.get(draw.mesh).and_then(Mesh::bounds);
-            bounds.into_iter().flat_map(move |(a, b)| {
-                let (a, b) = (a.as_dvec3(), b.as_dvec3());
-                (0..8).map(move |i| {
-                    model.transform_point3(DVec3::new(
-                        if i & 1 == 0 { a.x } else { b.x },
-                        if i & 2 == 0 { a.y } else { b.y },
-                        if i & 4 == 0 { a.z } else { b.z },
-                    ))
-                })
-            })
-        });
-        Self::from_points(corners)
+        Self::from_points(
+            scene
+                .draws
+                .iter()
+                .flat_map(|draw| draw_box_corners(scene, draw).into_iter().flatten()),
+        )
     }
 
     /// Centre of the box.
@@ -137,6 +128,17 @@ impl Bounds {
             1.0
         }
     }
+}
+
+/// The world-space corners of a draw's mesh box (`None` for a mesh with no finite position).
+fn draw_box_corners(scene: &Scene, draw: &Draw) -> Option<[DVec3; 8]> {
+    let (a, b) = scene.meshes.get(draw.mesh).and_then(Mesh::bounds)?;
+    let model = draw.model.as_dmat4();
+    let local = Bounds {
+        min: a.as_dvec3(),
+        max: b.as_dvec3(),
+    };
+    Some(local.corners().map(|c| model.transform_point3(c)))
 }
 
 /// Near and far planes around a sphere `distance` away with `radius`: near at half the
@@ -202,20 +204,15 @@ impl Silhouette {
             let Some(mesh) = scene.meshes.get(draw.mesh) else {
                 continue;
             };
-            let model = draw.model.as_dmat4();
             if points.len() + mesh.positions.len() <= MAX_SILHOUETTE_POINTS {
+                let model = draw.model.as_dmat4();
                 points.extend(
                     mesh.positions
                         .iter()
                         .map(|p| model.transform_point3(p.as_dvec3())),
                 );
-            } else if let Some((a, b)) = mesh.bounds() {
-                let corners = Bounds {
-                    min: a.as_dvec3(),
-                    max: b.as_dvec3(),
-                }
-                .corners();
-                points.extend(corners.map(|c| model.transform_point3(c)));
+            } else if let Some(corners) = draw_box_corners(scene, draw) {
+                points.extend(corners);
             }
         }
         Self::from_points(points)
@@ -284,6 +281,40 @@ impl ViewBasis {
     }
 }
 
+/// The lowest and highest projections (tangents) of points along one image axis, with the
+/// depths they lie at.
+struct Extent {
+    low: (f64, f64),
+    high: (f64, f64),
+}
+
+impl Default for Extent {
+    fn default() -> Self {
+        Self {
+            low: (f64::INFINITY, 1.0),
+            high: (f64::NEG_INFINITY, 1.0),
+        }
+    }
+}
+
+impl Extent {
+    fn include(&mut self, projection: f64, depth: f64) {
+        if projection < self.low.0 {
+            self.low = (projection, depth);
+        }
+        if projection > self.high.0 {
+            self.high = (projection, depth);
+        }
+    }
+
+    /// How far to move the camera along the axis (model units) so that the two extreme points,
+    /// each at its own depth, project to symmetric places.
+    fn centring_shift(&self) -> f64 {
+        let ((low, d_low), (high, d_high)) = (self.low, self.high);
+        (low + high) / (1.0 / d_low + 1.0 / d_high)
+    }
+}
+
 /// Tangents of the half field-of-view angles a framing fills: horizontal and vertical.
 fn fill_tangents(yfov: f64, aspect: f64) -> (f64, f64) {
     let ty = (0.5 * yfov).tan() * FRAMING_FILL;
@@ -334,31 +365,16 @@ impl CameraPose {
         // whose slack leaves every point inside (FRAMING_FILL < 1).
         let (mut nearest, mut farthest) = (f64::INFINITY, f64::NEG_INFINITY);
         for _ in 0..6 {
-            // Per axis: the lowest and highest projection and the depths they lie at.
-            let mut extent = [
-                (f64::MAX, 1.0),
-                (f64::MIN, 1.0),
-                (f64::MAX, 1.0),
-                (f64::MIN, 1.0),
-            ];
+            let (mut x, mut y) = (Extent::default(), Extent::default());
             (nearest, farthest) = (f64::INFINITY, f64::NEG_INFINITY);
             for p in points.iter().map(|&p| basis.coords(p)) {
                 let depth = distance - p.z;
-                let (px, py) = ((p.x - sx) / depth, (p.y - sy) / depth);
-                for (slot, value, lower) in
-                    [(0, px, true), (1, px, false), (2, py, true), (3, py, false)]
-                {
-                    if (lower && value < extent[slot].0) || (!lower && value > extent[slot].0) {
-                        extent[slot] = (value, depth);
-                    }
-                }
+                x.include((p.x - sx) / depth, depth);
+                y.include((p.y - sy) / depth, depth);
                 nearest = nearest.min(depth);
                 farthest = farthest.max(depth);
             }
-            let shift = |(lo, d_lo): (f64, f64), (hi, d_hi): (f64, f64)| {
-                (lo + hi) / (1.0 / d_lo + 1.0 / d_hi)
-            };
-            let (dx, dy) = (shift(extent[0], extent[1]), shift(extent[2], extent[3]));
+            let (dx, dy) = (x.centring_shift(), y.centring_shift());
             sx += dx;
             sy += dy;
             if dx.abs().max(dy.abs()) <= distance * 1e-9 {
