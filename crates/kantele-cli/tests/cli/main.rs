@@ -23,6 +23,7 @@ mod render;
 mod render_data;
 mod shared_scenes;
 mod texture_memory;
+mod thumbnail;
 // The viewer is an optional feature; the lean build has no `view` command to test.
 #[cfg(feature = "viewer")]
 mod view;
