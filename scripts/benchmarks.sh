@@ -11,6 +11,8 @@
 # Environment:
 #   FRAMES      timed frames per scene, backend and round (default 30)
 #   THREADS     Kantele's worker threads and llvmpipe's LP_NUM_THREADS (default: every CPU)
+#   MSAA        samples per pixel for both renderers (`--msaa`; default 1)
+#   STAGES      when set, a second table: Kantele's stage times and fragments shaded per scene
 #
 # The llvmpipe measured is the Mesa that the process's libEGL loads. To measure a particular
 # Mesa build, source the env.sh that the Mesa unpack tool writes into its folder first:
@@ -47,6 +49,13 @@ if [[ -n ${THREADS:-} ]]; then
     thread_args=(--threads "$THREADS")
     export LP_NUM_THREADS=$THREADS
 fi
+if [[ -n ${MSAA:-} ]]; then
+    if ! [[ $MSAA =~ ^[1-9][0-9]*$ ]]; then
+        echo "benchmarks: MSAA must be a positive integer" >&2
+        exit 1
+    fi
+    thread_args+=(--msaa "$MSAA")
+fi
 
 work=$(mktemp -d)
 trap 'rm -rf "$work"' EXIT
@@ -64,7 +73,7 @@ memory=$(awk '/^MemTotal:/ { printf "%.0f GiB", $2 / 1048576 }' /proc/meminfo 2>
 
 MODEL=${model:-unknown CPU} CPUS=$(nproc) MEMORY=${memory:-unknown memory} \
 KERNEL="$(uname -s) $(uname -r)" DATE=$(date -u +%Y-%m-%d) ROUNDS=$rounds FRAMES=$frames \
-SCENE_COUNT=${#scenes[@]} THREADS_ARG=${THREADS:-} \
+SCENE_COUNT=${#scenes[@]} THREADS_ARG=${THREADS:-} MSAA_ARG=${MSAA:-} STAGES=${STAGES:-} \
 python3 - "$work"/round-*.json <<'PY'
 import json
 import math
@@ -73,6 +82,7 @@ import statistics
 import sys
 
 medians = {}  # (scene, backend) -> {round: median ms}
+stages = {}   # scene -> [(geometry, binning, raster, fragments shaded)] of Kantele's rounds
 info = {}     # scene -> (width, height, triangles)
 about = {}    # backend -> the first available row
 errors = {}
@@ -90,6 +100,9 @@ for round_index, path in enumerate(sys.argv[1:]):
                 info[scene] = (row["width"], row["height"], row["triangles"])
             if row.get("available") and row.get("median_ms") is not None:
                 medians.setdefault((scene, backend), {})[round_index] = row["median_ms"]
+                if backend == "cpu" and row.get("geometry_ms") is not None:
+                    stages.setdefault(scene, []).append((row["geometry_ms"], row["binning_ms"],
+                                                         row["raster_ms"], row["fragments_shaded"]))
                 about.setdefault(backend, row)
             else:
                 errors.setdefault(backend, row.get("error") or "unavailable")
@@ -106,6 +119,8 @@ env = os.environ
 cpu, gl = about["cpu"], about["gl"]
 threads = env["THREADS_ARG"]
 threads_arg = f" --threads {threads}" if threads else ""
+if env["MSAA_ARG"]:
+    threads_arg += f" --msaa {env['MSAA_ARG']}"
 print(f"Machine: {env['MODEL']}, {env['CPUS']} CPUs, {env['MEMORY']}, {env['KERNEL']}.")
 print(f"Kantele: {cpu['build']}, {cpu['threads']} worker threads, isa `{cpu['isa']}`, "
       f"target `{cpu['target']}`; llvmpipe: {gl['renderer']}, target `{gl['target']}`.")
@@ -134,4 +149,15 @@ for scene in order:
 if logs:
     mean = math.exp(sum(logs) / len(logs))
     print(f"| **geometric mean** | | | | | **{mean:.2f}** | |")
+if stages and os.environ.get("STAGES"):
+    print()
+    print("Kantele's stages, median ms over the rounds:")
+    print()
+    print("| scene | geometry | binning | raster | fragments shaded |")
+    print("|---|---:|---:|---:|---:|")
+    for scene in order:
+        if scene in stages:
+            rows = stages[scene]
+            g, b, r = (statistics.median(row[k] for row in rows) for k in range(3))
+            print(f"| {scene} | {g:.3f} | {b:.3f} | {r:.3f} | {group(rows[-1][3])} |")
 PY

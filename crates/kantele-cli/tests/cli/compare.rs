@@ -4,7 +4,7 @@ use std::process::Command;
 
 use crate::common::{kantele, ok, stderr, stdout, TempDir, BIN};
 
-fn gl_available() -> bool {
+pub(crate) fn gl_available() -> bool {
     let o = kantele(&[
         "bench",
         "--builtin",

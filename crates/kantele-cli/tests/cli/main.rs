@@ -24,6 +24,7 @@ mod render_data;
 mod shared_scenes;
 mod texture_memory;
 mod thumbnail;
+mod workloads;
 // The viewer is an optional feature; the lean build has no `view` command to test.
 #[cfg(feature = "viewer")]
 mod view;
