@@ -22,12 +22,15 @@ use super::fragment::{
 };
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
-use super::shader::{constant_varyings, vertex_varyings, FragmentLanes, Interpolation, Shader};
+use super::shader::{
+    constant_varyings, vertex_varyings, FragmentLanes, Interpolation, LaneProgram, LaneProgramJob,
+    Shader,
+};
 use super::shading_isas::dispatch_shading;
 use crate::raster::bin::TileBins;
 use crate::raster::samples::{rasterize_samples, SampleCoverage, MAX_COVERAGE_PLANES};
 use crate::raster::Strategy;
-use crate::rop::{Framebuffer, TileBuffer};
+use crate::rop::{BlendMode, DepthFunc, Framebuffer, TileBuffer};
 use kantele_lanes::{F32x8, Isa, LaneKernel, Lanes, Mask8};
 use kantele_rules::fixed::{pixel_center, BLOCK_SIZE, TILE_SIZE};
 use kantele_rules::setup::TriangleSetup;
@@ -85,7 +88,7 @@ pub(super) fn raster_tiles_multisampled<J: RasterJob + ?Sized>(
 }
 
 /// Shades one triangle's covered samples in one multisampled tile with the instruction set
-/// `isa`.
+/// `isa`, running the draw's lane program ([`Shader::with_lane_program`], as the 1× path does).
 pub(super) fn shade_triangle_multisampled<S: Shader>(
     draw: &DrawCall<'_, S>,
     tri: &TriangleSetup,
@@ -94,34 +97,82 @@ pub(super) fn shade_triangle_multisampled<S: Shader>(
     tile: &mut TileBuffer,
     isa: Isa,
 ) -> RasterCounters {
-    dispatch_shading(
+    draw.shader.with_lane_program(ShadeSamplesJob {
+        draw,
+        tri,
+        attrs,
+        coverage,
+        tile,
         isa,
-        ShadeSamples {
-            draw,
-            tri,
-            attrs,
-            coverage,
-            tile,
-        },
-    )
+    })
 }
 
-/// One triangle in one multisampled tile, as a kernel compiled per instruction set.
-struct ShadeSamples<'k, 'a, S: Shader> {
+/// [`shade_triangle_multisampled`] waiting for the draw's lane program.
+struct ShadeSamplesJob<'k, 'a, S: Shader> {
     draw: &'k DrawCall<'a, S>,
+    tri: &'k TriangleSetup,
+    attrs: &'k [f32],
+    coverage: &'k SampleCoverage,
+    tile: &'k mut TileBuffer,
+    isa: Isa,
+}
+
+impl<S: Shader> LaneProgramJob for ShadeSamplesJob<'_, '_, S> {
+    type Output = RasterCounters;
+
+    #[inline(always)]
+    fn run<P: LaneProgram>(self, program: &P) -> RasterCounters {
+        let state = &self.draw.state;
+        let opaque_less = state.depth_test
+            && state.depth_func == DepthFunc::Less
+            && state.depth_write
+            && state.blend == BlendMode::Replace;
+        macro_rules! shade {
+            ($opaque_less:literal) => {
+                dispatch_shading(
+                    self.isa,
+                    ShadeSamples::<S, P, $opaque_less> {
+                        draw: self.draw,
+                        program,
+                        tri: self.tri,
+                        attrs: self.attrs,
+                        coverage: self.coverage,
+                        tile: self.tile,
+                    },
+                )
+            };
+        }
+        if opaque_less {
+            shade!(true)
+        } else {
+            shade!(false)
+        }
+    }
+}
+
+/// One triangle in one multisampled tile, as a kernel compiled per instruction set, lane
+/// program and state class: `OPAQUE_LESS` kernels (depth test LESS, depth write, Replace) test
+/// depth directly and write the shaded colour without reading the samples' colours (what
+/// blending with Replace would give, bit for bit).
+struct ShadeSamples<'k, 'a, S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> {
+    draw: &'k DrawCall<'a, S>,
+    program: &'k P,
     tri: &'k TriangleSetup,
     attrs: &'k [f32],
     coverage: &'k SampleCoverage,
     tile: &'k mut TileBuffer,
 }
 
-impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
+impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> LaneKernel
+    for ShadeSamples<'_, '_, S, P, OPAQUE_LESS>
+{
     type Output = RasterCounters;
 
     #[inline(always)]
     fn run<L: Lanes>(self, lanes: L) -> RasterCounters {
         let ShadeSamples {
             draw,
+            program,
             tri,
             attrs,
             coverage,
@@ -148,6 +199,12 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
         let mut counters = RasterCounters::default();
         let blocks_can_reject = draw.rejects_by_depth_bound();
         let none = lanes.mask_all(false);
+        // Depth at a covered sample is clamped to the vertex range (`TriangleLanes::depth`):
+        // within [0, 1] when that range is, so the range test is needed only otherwise (a NaN
+        // bound fails the comparison and keeps the test), as in the 1× path.
+        let depth_needs_range_test = !(tri.depth_range[0] >= 0.0 && tri.depth_range[1] <= 1.0);
+        let depth_test = OPAQUE_LESS || state.depth_test;
+        let depth_write = OPAQUE_LESS || state.depth_write;
 
         for block in coverage.blocks() {
             if blocks_can_reject && tile.block_occludes(block.index, tri.depth_range[0]) {
@@ -187,13 +244,18 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                     if bits == 0 {
                         continue;
                     }
-                    let mut active = lanes
-                        .mask_from_bits(bits)
-                        .and(depth.simd_ge(zero))
-                        .and(depth.simd_le(one));
-                    if state.depth_test {
+                    let mut active = lanes.mask_from_bits(bits);
+                    if depth_needs_range_test {
+                        active = active.and(depth.simd_ge(zero)).and(depth.simd_le(one));
+                    }
+                    if depth_test {
                         let stored = lanes.load_f32(tile.depth_plane_row(plane, index));
-                        active = active.and(state.depth_func.passes_lanes(lanes, depth, stored));
+                        let passes = if OPAQUE_LESS {
+                            depth.simd_lt(stored)
+                        } else {
+                            state.depth_func.passes_lanes(lanes, depth, stored)
+                        };
+                        active = active.and(passes);
                     }
                     pass[plane] = active;
                     any = any.or(active);
@@ -216,7 +278,7 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                     w,
                     interpolation: &interpolation,
                 };
-                let shaded = shader.fragment_lanes(&fragments);
+                let shaded = program.fragment_lanes(&fragments);
                 let keep = any.and(shaded.keep);
                 let active_count = any.count() as u64;
                 let kept = keep.count() as u64;
@@ -232,29 +294,35 @@ impl<S: Shader> LaneKernel for ShadeSamples<'_, '_, S> {
                     if keep_sample.none() {
                         continue;
                     }
-                    let [r, g, b, a] = tile.sample_color_row(sample, index);
-                    let dst = [
-                        lanes.load_f32(r),
-                        lanes.load_f32(g),
-                        lanes.load_f32(b),
-                        lanes.load_f32(a),
-                    ];
-                    let blended = state.blend.blend_lanes(lanes, src, dst);
-                    let (blended, nan_blended) = zero_nan_channels(lanes, blended, keep_sample);
-                    counters.nan_channels += nan_blended;
+                    let blended = if OPAQUE_LESS {
+                        // Replace: the sanitised source, as `blend_lanes` would return it.
+                        src
+                    } else {
+                        let [r, g, b, a] = tile.sample_color_row(sample, index);
+                        let dst = [
+                            lanes.load_f32(r),
+                            lanes.load_f32(g),
+                            lanes.load_f32(b),
+                            lanes.load_f32(a),
+                        ];
+                        let blended = state.blend.blend_lanes(lanes, src, dst);
+                        let (blended, nan_blended) = zero_nan_channels(lanes, blended, keep_sample);
+                        counters.nan_channels += nan_blended;
+                        blended
+                    };
                     let [r, g, b, a] = tile.sample_color_row_mut(sample, index);
                     blended[0].store_masked(keep_sample, r);
                     blended[1].store_masked(keep_sample, g);
                     blended[2].store_masked(keep_sample, b);
                     blended[3].store_masked(keep_sample, a);
-                    if state.depth_write {
+                    if depth_write {
                         depths[1 + sample]
                             .store_masked(keep_sample, tile.sample_depth_row_mut(sample, index));
                         wrote_depth = true;
                     }
                 }
                 let keep_centre = pass[0].and(shaded.keep);
-                if state.depth_write && keep_centre.any() {
+                if depth_write && keep_centre.any() {
                     depths[0].store_masked(keep_centre, tile.depth_row_mut(index));
                     wrote_depth = true;
                 }
