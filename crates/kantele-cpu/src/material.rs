@@ -319,17 +319,25 @@ impl Shader for MaterialShader<'_> {
     /// Opaque colour-pass draws without an emissive texture, untextured or with a base colour
     /// texture sampled with the glTF default (REPEAT, LINEAR / LINEAR_MIPMAP_LINEAR, a
     /// power-of-two sRGB texture), run a program compiled for their lighting and vertex colours
-    /// (`OpaqueUntextured`, `OpaqueTextured`); every other draw runs `fragment_lanes`.
+    /// (`OpaqueUntextured`, `Textured`); so do lit, alpha-masked or blended draws with such a
+    /// texture and no vertex colours (foliage cards, particles, decals: `Textured` with its
+    /// alpha); every other draw runs `fragment_lanes`.
     #[inline(always)]
     fn with_lane_program<J: LaneProgramJob>(&self, job: J) -> J::Output {
         if let Some(texture) = self.opaque_textured() {
             let (shader, vertex_colors) = (self, self.layout.color);
             return match (self.material.unlit, vertex_colors) {
-                (true, true) => job.run(&OpaqueTextured::<true, true> { shader, texture }),
-                (true, false) => job.run(&OpaqueTextured::<true, false> { shader, texture }),
-                (false, true) => job.run(&OpaqueTextured::<false, true> { shader, texture }),
-                (false, false) => job.run(&OpaqueTextured::<false, false> { shader, texture }),
+                (true, true) => job.run(&Textured::<true, true, false> { shader, texture }),
+                (true, false) => job.run(&Textured::<true, false, false> { shader, texture }),
+                (false, true) => job.run(&Textured::<false, true, false> { shader, texture }),
+                (false, false) => job.run(&Textured::<false, false, false> { shader, texture }),
             };
+        }
+        if let Some(texture) = self.alpha_textured() {
+            return job.run(&Textured::<false, false, true> {
+                shader: self,
+                texture,
+            });
         }
         let Some(program) = self.untextured_color else {
             return job.run(&ShaderLanes(self));
@@ -349,7 +357,7 @@ impl Shader for MaterialShader<'_> {
 
 impl<'a> MaterialShader<'a> {
     /// The base colour texture of an opaque colour-pass draw without an emissive texture, when
-    /// it is sampled in the [`TrilinearRepeat15`] configuration ([`OpaqueTextured`] then shades
+    /// it is sampled in the [`TrilinearRepeat15`] configuration ([`Textured`] then shades
     /// the draw).
     fn opaque_textured(&self) -> Option<TrilinearRepeat15<'a>> {
         let plain = self.pass == Pass::Color
@@ -358,20 +366,34 @@ impl<'a> MaterialShader<'a> {
         let (texture, sampler) = self.texture.filter(|_| plain)?;
         texture.trilinear_repeat15(&sampler)
     }
+
+    /// The base colour texture of a lit, alpha-masked or blended colour-pass draw without vertex
+    /// colours or an emissive texture, when it is sampled in the [`TrilinearRepeat15`]
+    /// configuration ([`Textured`] with its alpha then shades the draw).
+    fn alpha_textured(&self) -> Option<TrilinearRepeat15<'a>> {
+        let plain = self.pass == Pass::Color
+            && self.emissive_texture.is_none()
+            && !self.material.unlit
+            && !self.layout.color
+            && !matches!(self.material.alpha_mode, AlphaMode::Opaque);
+        let (texture, sampler) = self.texture.filter(|_| plain)?;
+        texture.trilinear_repeat15(&sampler)
+    }
 }
 
-/// The lane program of an opaque colour-pass draw whose base colour texture is sampled in the
-/// [`TrilinearRepeat15`] configuration, without an emissive texture, with lighting (`UNLIT`) and
-/// vertex colours (`VERTEX_COLORS`) fixed at compile time: the operations of
-/// [`MaterialShader::shade_lanes`] for such a draw, in the same order, with no branch on the
-/// material, the pass, the wrap modes, the filters or the texel storage.
-struct OpaqueTextured<'s, 'a, const UNLIT: bool, const VERTEX_COLORS: bool> {
+/// The lane program of a colour-pass draw whose base colour texture is sampled in the
+/// [`TrilinearRepeat15`] configuration, without an emissive texture, with lighting (`UNLIT`),
+/// vertex colours (`VERTEX_COLORS`) and whether the draw is opaque (`ALPHA` false) or
+/// alpha-masked or blended (`ALPHA` true: alpha and the kept lanes by the alpha mode) fixed at
+/// compile time: the operations of [`MaterialShader::shade_lanes`] for such a draw, in the same
+/// order, with no branch on the pass, the wrap modes, the filters or the texel storage.
+struct Textured<'s, 'a, const UNLIT: bool, const VERTEX_COLORS: bool, const ALPHA: bool> {
     shader: &'s MaterialShader<'a>,
     texture: TrilinearRepeat15<'a>,
 }
 
-impl<const UNLIT: bool, const VERTEX_COLORS: bool> LaneProgram
-    for OpaqueTextured<'_, '_, UNLIT, VERTEX_COLORS>
+impl<const UNLIT: bool, const VERTEX_COLORS: bool, const ALPHA: bool> LaneProgram
+    for Textured<'_, '_, UNLIT, VERTEX_COLORS, ALPHA>
 {
     /// A texture coordinate is rarely the same at a triangle's three vertices, and the sampler
     /// makes these the largest kernels: compiled once.
@@ -396,9 +418,15 @@ impl<const UNLIT: bool, const VERTEX_COLORS: bool> LaneProgram
             [du_dy, dv_dy],
             f.active,
         );
-        for c in 0..3 {
+        let channels = if ALPHA { 4 } else { 3 };
+        for c in 0..channels {
             base[c] = base[c] * texel[c];
         }
+        let (alpha, keep) = if ALPHA {
+            MaterialShader::alpha_lanes(lanes, material.alpha_mode, base[3])
+        } else {
+            (lanes.splat_f32(1.0), lanes.mask_all(true))
+        };
         let e = material.emissive;
         let emissive = [
             lanes.splat_f32(e.x),
@@ -416,8 +444,8 @@ impl<const UNLIT: bool, const VERTEX_COLORS: bool> LaneProgram
             shader.lit_lanes(lanes, n, &base, emissive)
         };
         ShadedLanes {
-            color: [r, g, b, lanes.splat_f32(1.0)],
-            keep: lanes.mask_all(true),
+            color: [r, g, b, alpha],
+            keep,
         }
     }
 }

@@ -293,6 +293,96 @@ fn specialised_lane_programs_shade_as_the_general_one() {
     }
 }
 
+/// The textured program of alpha-masked and blended draws gives the bits of the general
+/// program: alpha (the factor's times the texel's, which ramps across the texture) and the
+/// lanes a mask discards, on the receding quad of the other programs' test, single-sided and
+/// double-sided.
+#[test]
+fn alpha_textured_program_shades_as_the_general_one() {
+    let size = 64u32;
+    let rgba: Vec<u8> = (0..size * size)
+        .flat_map(|i| {
+            let (x, y) = (i % size, i / size);
+            [
+                (x * 4) as u8,
+                (y * 4) as u8,
+                ((x ^ y) * 4) as u8,
+                (x * 4 + 2) as u8,
+            ]
+        })
+        .collect();
+    let texture = Texture::from_rgba8(size, size, &rgba, ColorSpace::Srgb).expect("texture");
+    texture.prepare_lane_sampling();
+    let mesh = Mesh {
+        positions: vec![
+            Vec3::new(-1.0, -0.6, 0.5),
+            Vec3::new(1.0, -0.6, 0.5),
+            Vec3::new(1.0, 0.4, -8.0),
+            Vec3::new(-1.0, 0.4, -8.0),
+        ],
+        normals: Some(vec![Vec3::Y, Vec3::new(0.3, 1.0, 0.0), Vec3::Z, Vec3::X]),
+        texcoords: Some(vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(3.0, 0.0),
+            Vec2::new(3.0, 24.0),
+            Vec2::new(0.0, 24.0),
+        ]),
+        indices: vec![0, 1, 2, 0, 2, 3],
+        ..Mesh::default()
+    };
+    let view_projection = Mat4::perspective_rh(1.0, 1.5, 0.1, 20.0)
+        * Mat4::look_at_rh(Vec3::new(0.0, 0.6, 1.6), Vec3::new(0.0, 0.0, -2.0), Vec3::Y);
+    let lighting = Lighting {
+        to_light: Vec3::new(0.3, 0.9, 0.3).normalize(),
+        light_color: Vec3::ONE,
+        ambient: 0.1,
+    };
+    // Pixels outside the quad: the blended draw keeps every lane it covers.
+    let mut uncovered = 0;
+    for alpha_mode in [AlphaMode::Blend, AlphaMode::Mask { cutoff: 0.4 }] {
+        for double_sided in [false, true] {
+            let material = Material {
+                base_color_factor: Vec4::new(0.9, 0.8, 0.7, 0.8),
+                alpha_mode,
+                double_sided,
+                emissive: Vec3::new(0.05, 0.0, 0.02),
+                ..Material::default()
+            };
+            let shader = MaterialShader::new(
+                Mat4::IDENTITY,
+                view_projection,
+                lighting,
+                &material,
+                Some((&texture, TrilinearRepeat15::SAMPLER)),
+                Pass::Color,
+                (1, 1),
+            )
+            .with_vertex_colors(false);
+            let case = format!("{alpha_mode:?}, double-sided {double_sided}");
+            assert!(shader.alpha_textured().is_some(), "{case}");
+            let specialised = render(&shader, &mesh);
+            let general = render(&GeneralProgram(&shader), &mesh);
+            let cleared = specialised
+                .chunks_exact(4)
+                .filter(|c| c[2] == 0.3f32.to_bits())
+                .count();
+            if let AlphaMode::Mask { .. } = alpha_mode {
+                // The mask keeps some of the quad and discards some (the clear shows there).
+                assert!(
+                    cleared > uncovered + 200 && cleared < 64 * 96 - 200,
+                    "{case}: {cleared} cleared, {uncovered} outside the quad"
+                );
+            } else {
+                uncovered = cleared;
+                let alphas: std::collections::HashSet<u32> =
+                    specialised.chunks_exact(4).map(|c| c[3]).collect();
+                assert!(alphas.len() > 20, "{case}: alpha does not vary");
+            }
+            assert!(specialised == general, "{case}: the programs differ");
+        }
+    }
+}
+
 /// A built-in shader seen only through its per-fragment entry: the default `fragment_lanes`
 /// (each lane's scalar fragment, [`FragmentLanes::lane`]).
 struct ScalarFragments<'s, 'a>(&'s MaterialShader<'a>);
