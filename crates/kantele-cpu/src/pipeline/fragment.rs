@@ -198,11 +198,7 @@ impl<S: Shader> LaneProgramJob for ShadeTriangleJob<'_, '_, S> {
 
     #[inline(always)]
     fn run<P: LaneProgram>(self, program: &P) -> RasterCounters {
-        let state = &self.draw.state;
-        let opaque_less = state.depth_test
-            && state.depth_func == DepthFunc::Less
-            && state.depth_write
-            && state.blend == BlendMode::Replace;
+        let opaque_less = is_opaque_less(&self.draw.state);
         macro_rules! shade {
             ($opaque_less:literal, $constant:literal) => {
                 dispatch_shading(
@@ -235,6 +231,15 @@ impl<S: Shader> LaneProgramJob for ShadeTriangleJob<'_, '_, S> {
             (false, true) => shade!(false, true),
         }
     }
+}
+
+/// Whether `state` is the common opaque state that the per-pixel kernels (1× and multisampled)
+/// compile or run a path of their own for: depth test LESS with depth writes, no blending.
+pub(super) fn is_opaque_less(state: &RenderState) -> bool {
+    state.depth_test
+        && state.depth_func == DepthFunc::Less
+        && state.depth_write
+        && state.blend == BlendMode::Replace
 }
 
 /// A triangle's per-pixel constants splatted across the lanes, and the steps every lane kernel

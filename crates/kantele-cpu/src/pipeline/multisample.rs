@@ -18,7 +18,7 @@
 use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::call::DrawCall;
 use super::fragment::{
-    binned_triangles, RasterCounters, RasterJob, TriangleLanes, TILES_PER_PIECE,
+    binned_triangles, is_opaque_less, RasterCounters, RasterJob, TriangleLanes, TILES_PER_PIECE,
 };
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
@@ -30,7 +30,7 @@ use super::shading_isas::dispatch_shading;
 use crate::raster::bin::TileBins;
 use crate::raster::samples::{rasterize_samples, SampleCoverage, MAX_COVERAGE_PLANES};
 use crate::raster::Strategy;
-use crate::rop::{BlendMode, DepthFunc, Framebuffer, TileBuffer};
+use crate::rop::{Framebuffer, TileBuffer};
 use kantele_lanes::{F32x8, Isa, LaneKernel, Lanes, Mask8};
 use kantele_rules::fixed::{pixel_center, BLOCK_SIZE, TILE_SIZE};
 use kantele_rules::setup::TriangleSetup;
@@ -122,11 +122,7 @@ impl<S: Shader> LaneProgramJob for ShadeSamplesJob<'_, '_, S> {
 
     #[inline(always)]
     fn run<P: LaneProgram>(self, program: &P) -> RasterCounters {
-        let state = &self.draw.state;
-        let opaque_less = state.depth_test
-            && state.depth_func == DepthFunc::Less
-            && state.depth_write
-            && state.blend == BlendMode::Replace;
+        let opaque_less = is_opaque_less(&self.draw.state);
         macro_rules! shade {
             ($opaque_less:literal) => {
                 dispatch_shading(
