@@ -122,46 +122,40 @@ impl<S: Shader> LaneProgramJob for ShadeSamplesJob<'_, '_, S> {
 
     #[inline(always)]
     fn run<P: LaneProgram>(self, program: &P) -> RasterCounters {
-        let opaque_less = is_opaque_less(&self.draw.state);
-        macro_rules! shade {
-            ($opaque_less:literal) => {
-                dispatch_shading(
-                    self.isa,
-                    ShadeSamples::<S, P, $opaque_less> {
-                        draw: self.draw,
-                        program,
-                        tri: self.tri,
-                        attrs: self.attrs,
-                        coverage: self.coverage,
-                        tile: self.tile,
-                    },
-                )
-            };
-        }
-        if opaque_less {
-            shade!(true)
-        } else {
-            shade!(false)
-        }
+        dispatch_shading(
+            self.isa,
+            ShadeSamples::<S, P> {
+                draw: self.draw,
+                program,
+                tri: self.tri,
+                attrs: self.attrs,
+                coverage: self.coverage,
+                tile: self.tile,
+                opaque_less: is_opaque_less(&self.draw.state),
+            },
+        )
     }
 }
 
-/// One triangle in one multisampled tile, as a kernel compiled per instruction set, lane
-/// program and state class: `OPAQUE_LESS` kernels (depth test LESS, depth write, Replace) test
-/// depth directly and write the shaded colour without reading the samples' colours (what
-/// blending with Replace would give, bit for bit).
-struct ShadeSamples<'k, 'a, S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> {
+/// One triangle in one multisampled tile, as a kernel compiled per instruction set and lane
+/// program. For the commonest state (`opaque_less`: depth test LESS, depth write, Replace) it
+/// tests depth directly and writes the shaded colour without reading the samples' colours (what
+/// blending with Replace would give, bit for bit). That is a branch per row, not a kernel of its
+/// own: a second kernel per lane program cost build time and memory (the largest part of the
+/// renderer's compile) and gave no measurable speed, the shading program dominating a
+/// multisampled row.
+struct ShadeSamples<'k, 'a, S: Shader, P: LaneProgram> {
     draw: &'k DrawCall<'a, S>,
     program: &'k P,
     tri: &'k TriangleSetup,
     attrs: &'k [f32],
     coverage: &'k SampleCoverage,
     tile: &'k mut TileBuffer,
+    /// The draw's state is [`is_opaque_less`].
+    opaque_less: bool,
 }
 
-impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> LaneKernel
-    for ShadeSamples<'_, '_, S, P, OPAQUE_LESS>
-{
+impl<S: Shader, P: LaneProgram> LaneKernel for ShadeSamples<'_, '_, S, P> {
     type Output = RasterCounters;
 
     #[inline(always)]
@@ -173,6 +167,7 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> LaneKernel
             attrs,
             coverage,
             tile,
+            opaque_less,
         } = self;
         let state = &draw.state;
         let shader = draw.shader;
@@ -199,8 +194,8 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> LaneKernel
         // within [0, 1] when that range is, so the range test is needed only otherwise (a NaN
         // bound fails the comparison and keeps the test), as in the 1× path.
         let depth_needs_range_test = !(tri.depth_range[0] >= 0.0 && tri.depth_range[1] <= 1.0);
-        let depth_test = OPAQUE_LESS || state.depth_test;
-        let depth_write = OPAQUE_LESS || state.depth_write;
+        let depth_test = opaque_less || state.depth_test;
+        let depth_write = opaque_less || state.depth_write;
 
         for block in coverage.blocks() {
             if blocks_can_reject && tile.block_occludes(block.index, tri.depth_range[0]) {
@@ -246,7 +241,7 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> LaneKernel
                     }
                     if depth_test {
                         let stored = lanes.load_f32(tile.depth_plane_row(plane, index));
-                        let passes = if OPAQUE_LESS {
+                        let passes = if opaque_less {
                             depth.simd_lt(stored)
                         } else {
                             state.depth_func.passes_lanes(lanes, depth, stored)
@@ -290,7 +285,7 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool> LaneKernel
                     if keep_sample.none() {
                         continue;
                     }
-                    let blended = if OPAQUE_LESS {
+                    let blended = if opaque_less {
                         // Replace: the sanitised source, as `blend_lanes` would return it.
                         src
                     } else {
