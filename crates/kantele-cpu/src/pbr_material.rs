@@ -816,6 +816,13 @@ struct PbrProgram<'s, 'a>(&'s PbrShader<'a>);
 impl LaneProgram for PbrProgram<'_, '_> {
     const CONSTANT_KERNELS: bool = false;
 
+    /// Each lane is shaded from its own values: its varyings and their derivatives, its texture
+    /// samples (whose results do not depend on which lanes share a call, see
+    /// `sample_grad_lanes`) and its environment lookups (gathers per lane); the fragment's
+    /// position on screen is never read. Most PBR models are finely tessellated (about four
+    /// fragments a triangle in EnvironmentTest), where packing fills the lanes.
+    const PACKED_ROWS: bool = true;
+
     #[inline(always)]
     fn fragment_lanes<L: Lanes>(&self, fragments: &FragmentLanes<'_, L>) -> ShadedLanes<L> {
         let (color, keep) = self.0.shade(fragments);

@@ -513,11 +513,15 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
             let mut kept_bits = 0u64;
             let columns = triangle.column_terms(lanes, pixel_center(block.x as i64) - v0x);
             let mut rows = tile.block_rows_mut(TileBuffer::index(block.x, block.y));
-            if P::PACKED_ROWS && !CONSTANT && packing_saves_a_row(block.mask) {
-                // The rows' tests, their fragments packed one after another.
-                let mut row_active = [0u8; 8];
-                let mut row_depth = [zero; 8];
-                let mut count = 0;
+            // Packed (see `packed_rows`): the rows' tests first, their fragments packed one
+            // after another, then the program eight packed fragments at a time, then each
+            // row's results back in its lanes. Otherwise the program runs row by row. The
+            // program has one call site for both, so it is compiled once per kernel.
+            let pack = P::PACKED_ROWS && !CONSTANT && packing_saves_a_row(block.mask);
+            let mut row_active = [0u8; 8];
+            let mut row_depth = [zero; 8];
+            let mut count = 0;
+            if pack {
                 for row in 0..8 {
                     let row_bits = (block.mask >> (8 * row)) as u8;
                     if row_bits == 0 {
@@ -536,26 +540,66 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
                     packed.pack(lanes, count, bits, bary, depth);
                     count += bits.count_ones() as usize;
                 }
-                // The program, eight packed fragments at a time.
-                for group in (0..count).step_by(8) {
+            }
+            let calls = if pack { count.div_ceil(8) } else { 8 };
+            for call in 0..calls {
+                // The fragments of this call: a packed group, or a row.
+                let (active, depth, bary, y) = if pack {
+                    let group = 8 * call;
                     let active =
                         lanes.mask_from_bits((0xffu16 >> (8 - (count - group).min(8))) as u8);
                     let (bary, depth) = packed.group(lanes, group, one);
-                    let shaded = program.fragment_lanes(&triangle.fragments(
-                        tri,
-                        &interpolation,
-                        active,
-                        depth,
-                        bary,
-                        [block.x, block.y],
-                    ));
-                    packed.store_shaded::<L>(
-                        group,
-                        shaded.color,
-                        active.and(shaded.keep),
-                        [zero, one],
-                    );
+                    (active, depth, bary, block.y)
+                } else {
+                    let (row, at) = (call, BlockRows::row_offset(call));
+                    let row_bits = (block.mask >> (8 * row)) as u8;
+                    let y = block.y + row as i32;
+                    // No closure around lane code here: LLVM may compile its body out of line,
+                    // without the kernel's instruction set.
+                    let mut active = lanes.mask_all(false);
+                    let (mut depth, mut bary) = (zero, [zero; 3]);
+                    if row_bits != 0 {
+                        let dy = pixel_center(y as i64) - v0y;
+                        bary = triangle.barycentrics_in_row(lanes, &columns, dy);
+                        depth = triangle.depth(bary);
+                        active = rules.active(lanes, row_bits, depth, &rows, at, &pending);
+                    }
+                    if active.none() {
+                        rules.store(lanes, None, &mut rows, at, &pending);
+                        continue;
+                    }
+                    (active, depth, bary, y)
+                };
+                let shaded = program.fragment_lanes(&triangle.fragments(
+                    tri,
+                    &interpolation,
+                    active,
+                    depth,
+                    bary,
+                    [block.x, y],
+                ));
+                let keep = active.and(shaded.keep);
+                if pack {
+                    packed.store_shaded::<L>(8 * call, shaded.color, keep, [zero, one]);
+                    continue;
                 }
+                let at = BlockRows::row_offset(call);
+                shaded_bits |= (active.bits() as u64) << (8 * call);
+                kept_bits |= (keep.bits() as u64) << (8 * call);
+                let written = rules
+                    .finish(
+                        lanes,
+                        shaded.color,
+                        keep,
+                        &rows,
+                        at,
+                        &pending,
+                        &mut counters,
+                    )
+                    .map(|color| (color, depth, keep));
+                rules.store(lanes, written, &mut rows, at, &pending);
+            }
+            if pack {
                 // Each row's results back in its lanes, blended and stored.
                 let mut group_at = 0;
                 for row in 0..8 {
@@ -571,51 +615,6 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
                         rules
                             .finish(lanes, color, keep, &rows, at, &pending, &mut counters)
                             .map(|color| (color, row_depth[row], keep))
-                    };
-                    rules.store(lanes, written, &mut rows, at, &pending);
-                }
-            } else {
-                for row in 0..8 {
-                    let at = BlockRows::row_offset(row);
-                    let written = 'row: {
-                        let row_bits = (block.mask >> (8 * row)) as u8;
-                        if row_bits == 0 {
-                            break 'row None;
-                        }
-                        let y = block.y + row as i32;
-                        let bary = triangle.barycentrics_in_row(
-                            lanes,
-                            &columns,
-                            pixel_center(y as i64) - v0y,
-                        );
-                        let depth = triangle.depth(bary);
-                        let active = rules.active(lanes, row_bits, depth, &rows, at, &pending);
-                        let active_bits = active.bits();
-                        if active_bits == 0 {
-                            break 'row None;
-                        }
-                        shaded_bits |= (active_bits as u64) << (8 * row);
-                        let shaded = program.fragment_lanes(&triangle.fragments(
-                            tri,
-                            &interpolation,
-                            active,
-                            depth,
-                            bary,
-                            [block.x, y],
-                        ));
-                        let keep = active.and(shaded.keep);
-                        kept_bits |= (keep.bits() as u64) << (8 * row);
-                        rules
-                            .finish(
-                                lanes,
-                                shaded.color,
-                                keep,
-                                &rows,
-                                at,
-                                &pending,
-                                &mut counters,
-                            )
-                            .map(|color| (color, depth, keep))
                     };
                     rules.store(lanes, written, &mut rows, at, &pending);
                 }
