@@ -13,7 +13,7 @@ use std::f32::consts::PI;
 use std::sync::{Arc, OnceLock};
 
 use glam::{Vec2, Vec3};
-use kantele_lanes::{F32x8, I32x8, Lanes, Mask8, Scalar};
+use kantele_lanes::{F32x8, I32x8, Lanes, Mask8, Scalar, TexelGather};
 
 use crate::error::RenderError;
 
@@ -28,6 +28,11 @@ pub const BRDF_TABLE_SIZE: usize = 32;
 
 /// Importance samples per texel of the pre-filtered levels and per cell of the BRDF table.
 const SAMPLES: u32 = 128;
+
+/// The largest radiance an environment texel keeps (larger ones are clamped to it): far above
+/// any real light (the sun's disc is about 1e9 in the units HDR images use), and small enough
+/// that sums over a whole image stay finite.
+pub const MAX_RADIANCE: f32 = 1e30;
 
 /// The largest equirectangular image accepted, in pixels per side.
 pub const MAX_ENVIRONMENT_SIZE: u32 = 16384;
@@ -105,7 +110,10 @@ pub struct Environment {
     /// The source's size `(width, height)`, for reports.
     pub source_size: (u32, u32),
     /// The texels of every level, one after another (level `k` from `LEVEL_OFFSETS[k]`), as
-    /// `f32` bits with RGB interleaved: what the lane lookups gather from.
+    /// `f32` bits, four words a texel (RGB and a 0), then one texel of zeros: what the lane
+    /// lookups read. A bilinear row's two texels are eight neighbouring words, two 16-byte
+    /// reads per lane ([`TexelGather::gather_u32_quad`]); the texel after the last lets a read
+    /// at the last column (whose right texel has weight 0) stay inside the table.
     texel_bits: Vec<u32>,
 }
 
@@ -226,6 +234,10 @@ impl EnvironmentLight {
 
 /// The split-sum terms `(A, B)` at `NdotV` and `roughness`, per lane: read bilinearly from
 /// [`brdf_table`], clamped to its cell centres (a non-finite coordinate reads as 1).
+///
+/// Each row's two cells are read together, the right one always at the next column: the
+/// clamped right column differs from it only at the last column, where the coordinate is that
+/// cell's centre and the right cell's weight is 0 (every cell is finite).
 #[inline(always)]
 pub fn brdf_ab_lanes<L: Lanes>(lanes: L, n_dot_v: L::F32, roughness: L::F32) -> [L::F32; 2] {
     let n = BRDF_TABLE_SIZE as f32;
@@ -244,21 +256,20 @@ pub fn brdf_ab_lanes<L: Lanes>(lanes: L, n_dot_v: L::F32, roughness: L::F32) -> 
     let (fx, fy) = (x - x0, y - y0);
     let (x0, y0) = (x0.to_i32_trunc(), y0.to_i32_trunc());
     let last = lanes.splat_i32(BRDF_TABLE_SIZE as i32 - 1);
-    let step = lanes.splat_i32(1);
-    let (x1, y1) = ((x0 + step).min(last), (y0 + step).min(last));
+    let y1 = (y0 + lanes.splat_i32(1)).min(last);
     let size = lanes.splat_i32(BRDF_TABLE_SIZE as i32);
     let table = brdf_table_bits();
-    // Cell (x, y) holds A at 2 (y size + x) and B after it.
-    let cell = |x: L::I32, y: L::I32| (y * size + x).shl::<1>();
-    let corners = [cell(x0, y0), cell(x1, y0), cell(x0, y1), cell(x1, y1)];
+    // Cell (x, y) holds A at 2 (y size + x) and B after it: [A, B, A, B] of a row's two cells.
+    let cell = |y: L::I32| (y * size + x0).shl::<1>();
+    let top = cell(y0).gather_u32_quad(table);
+    let bottom = cell(y1).gather_u32_quad(table);
     let mut out = [zero; 2];
     for (c, o) in out.iter_mut().enumerate() {
-        let channel = lanes.splat_i32(c as i32);
         let t = [
-            gather_f32::<L>(corners[0] + channel, table),
-            gather_f32::<L>(corners[1] + channel, table),
-            gather_f32::<L>(corners[2] + channel, table),
-            gather_f32::<L>(corners[3] + channel, table),
+            L::F32::from_bits(top[c]),
+            L::F32::from_bits(top[2 + c]),
+            L::F32::from_bits(bottom[c]),
+            L::F32::from_bits(bottom[2 + c]),
         ];
         let top = t[0] + (t[1] - t[0]) * fx;
         let bottom = t[2] + (t[3] - t[2]) * fx;
@@ -285,14 +296,6 @@ fn normalize_or_zero_lanes<L: Lanes>(lanes: L, v: [L::F32; 3]) -> [L::F32; 3] {
     ]
 }
 
-/// The `f32` whose bits `table` holds at `index`, per lane (see [`I32x8::gather_u32`]). Lane
-/// code here never hands lanes to closure-taking helpers such as `[T; N]::map`: LLVM may
-/// keep their bodies out of line, compiled without the kernel's instruction set.
-#[inline(always)]
-fn gather_f32<L: Lanes>(index: L::I32, table: &[u32]) -> L::F32 {
-    L::F32::from_bits(index.gather_u32(table))
-}
-
 /// [`octahedral_encode`] per lane, operation for operation.
 #[inline(always)]
 fn octahedral_encode_lanes<L: Lanes>(lanes: L, d: &[L::F32; 3]) -> [L::F32; 2] {
@@ -314,6 +317,11 @@ fn octahedral_encode_lanes<L: Lanes>(lanes: L, d: &[L::F32; 3]) -> [L::F32; 2] {
 
 /// [`OctahedralLevel::sample`] per lane, each lane in its own `level`, from `table`
 /// ([`Environment::texel_bits`]) at octahedral coordinates `uv`.
+///
+/// Each row's two texels are read together, the right one always at the next column: the
+/// clamped right column of the scalar lookup differs from it only at the last column, where
+/// the coordinate is clamped to that column's centre and the right texel's weight is 0, so the
+/// blend gives the left texel there too (every texel is finite).
 #[inline(always)]
 fn sample_level_lanes<L: Lanes>(
     lanes: L,
@@ -322,10 +330,10 @@ fn sample_level_lanes<L: Lanes>(
     uv: &[L::F32; 2],
 ) -> [L::F32; 3] {
     let zero = lanes.splat_f32(0.0);
-    let size_i = level.gather_u32(&LEVEL_SIZES);
+    let size_i = level_entry::<L>(lanes, &LANE_LEVEL_SIZES, level);
     let size = size_i.to_f32();
     let stride = size_i + lanes.splat_i32(2);
-    let first = level.gather_u32(&LEVEL_OFFSETS);
+    let first = level_entry::<L>(lanes, &LANE_LEVEL_OFFSETS, level);
     let half = lanes.splat_f32(0.5);
     let limit = size + lanes.splat_f32(1.0);
     // Texel centre i sits at (i + 0.5) / size; the border shifts indices by one.
@@ -335,23 +343,52 @@ fn sample_level_lanes<L: Lanes>(
     let (fx, fy) = (x - x0, y - y0);
     let (x0, y0) = (x0.to_i32_trunc(), y0.to_i32_trunc());
     let edge = stride - lanes.splat_i32(1);
-    let step = lanes.splat_i32(1);
-    let (x1, y1) = ((x0 + step).min(edge), (y0 + step).min(edge));
-    let three = lanes.splat_i32(3);
-    let texel = |x: L::I32, y: L::I32| (first + y * stride + x) * three;
-    let corners = [texel(x0, y0), texel(x1, y0), texel(x0, y1), texel(x1, y1)];
+    let y1 = (y0 + lanes.splat_i32(1)).min(edge);
+    // Word index of a row's left texel; its right texel follows four words on.
+    let texel = |y: L::I32| (first + y * stride + x0).shl::<2>();
+    let (top, bottom) = (texel(y0), texel(y1));
+    let right = lanes.splat_i32(4);
+    let [top_left, top_right, bottom_left, bottom_right] = [
+        top.gather_u32_quad(table),
+        (top + right).gather_u32_quad(table),
+        bottom.gather_u32_quad(table),
+        (bottom + right).gather_u32_quad(table),
+    ];
     let mut out = [zero; 3];
     for (c, o) in out.iter_mut().enumerate() {
-        let channel = lanes.splat_i32(c as i32);
         let t = [
-            gather_f32::<L>(corners[0] + channel, table),
-            gather_f32::<L>(corners[1] + channel, table),
-            gather_f32::<L>(corners[2] + channel, table),
-            gather_f32::<L>(corners[3] + channel, table),
+            L::F32::from_bits(top_left[c]),
+            L::F32::from_bits(top_right[c]),
+            L::F32::from_bits(bottom_left[c]),
+            L::F32::from_bits(bottom_right[c]),
         ];
         let top = t[0] + (t[1] - t[0]) * fx;
         let bottom = t[2] + (t[3] - t[2]) * fx;
         *o = top + (bottom - top) * fy;
+    }
+    out
+}
+
+/// Lane `k`: `table[level[k]]`, for levels in `0..SPECULAR_LEVELS` (one permute, no gather).
+#[inline(always)]
+fn level_entry<L: Lanes>(lanes: L, table: &[i32; 8], level: L::I32) -> L::I32 {
+    L::F32::from_bits(lanes.load_i32(table))
+        .permute(level)
+        .to_bits()
+}
+
+/// [`LEVEL_SIZES`] as eight lanes, for [`level_entry`].
+const LANE_LEVEL_SIZES: [i32; 8] = lane_table(LEVEL_SIZES);
+
+/// [`LEVEL_OFFSETS`] as eight lanes, for [`level_entry`].
+const LANE_LEVEL_OFFSETS: [i32; 8] = lane_table(LEVEL_OFFSETS);
+
+const fn lane_table(values: [u32; SPECULAR_LEVELS]) -> [i32; 8] {
+    let mut out = [0; 8];
+    let mut k = 0;
+    while k < SPECULAR_LEVELS {
+        out[k] = values[k] as i32;
+        k += 1;
     }
     out
 }
@@ -416,12 +453,16 @@ pub fn brdf_table() -> &'static [[f32; 2]] {
     })
 }
 
-/// [`brdf_table`] as `f32` bits, `(A, B)` interleaved, for gathers.
+/// [`brdf_table`] as `f32` bits, `(A, B)` interleaved, then one cell of zeros: a bilinear
+/// row's two cells are four neighbouring words, one 16-byte read per lane
+/// ([`TexelGather::gather_u32_quad`]), and the extra cell keeps a read at the last cell inside
+/// the table.
 fn brdf_table_bits() -> &'static [u32] {
     static BITS: OnceLock<Vec<u32>> = OnceLock::new();
     BITS.get_or_init(|| {
         brdf_table()
             .iter()
+            .chain([&[0.0; 2]])
             .flat_map(|ab| ab.map(f32::to_bits))
             .collect()
     })
@@ -504,7 +545,8 @@ impl Environment {
 
     /// Prepares an equirectangular image (`width × height` linear RGB, row 0 at the top =
     /// straight up, column 0 looking along −Z, turning towards +X) for shading. Non-finite
-    /// and negative texels count as 0.
+    /// and negative texels count as 0, and texels above [`MAX_RADIANCE`] as that: no sum
+    /// the preparation makes then overflows, and every prepared value is finite.
     pub fn from_equirect(width: u32, height: u32, texels: &[Vec3]) -> Result<Self, RenderError> {
         if width < 2
             || height < 1
@@ -519,7 +561,7 @@ impl Environment {
         }
         let clean = |t: Vec3| {
             if t.is_finite() {
-                t.max(Vec3::ZERO)
+                t.clamp(Vec3::ZERO, Vec3::splat(MAX_RADIANCE))
             } else {
                 Vec3::ZERO
             }
@@ -544,7 +586,8 @@ impl Environment {
         let texel_bits = levels
             .iter()
             .flat_map(|level| level.texels.iter())
-            .flat_map(|texel| texel.map(f32::to_bits))
+            .chain([&[0.0; 3]])
+            .flat_map(|&[r, g, b]| [r, g, b, 0.0].map(f32::to_bits))
             .collect();
         Ok(Self {
             irradiance_sh,

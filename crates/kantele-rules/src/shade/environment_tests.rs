@@ -121,6 +121,36 @@ fn bad_sources_are_refused() {
     assert!(env.irradiance_sh.iter().all(|c| *c == Vec3::ZERO));
 }
 
+/// Texels up to `f32::MAX` are clamped to [`MAX_RADIANCE`]: every prepared value (the levels'
+/// texels, the harmonics) stays finite, as the lane lookups' reads of a row's two texels
+/// require, and a lookup gives a finite radiance of that order.
+#[test]
+fn the_brightest_sources_prepare_finite_values() {
+    let (width, height) = (64u32, 32u32);
+    let texels: Vec<Vec3> = (0..width * height)
+        .map(|i| match i % 3 {
+            0 => Vec3::splat(f32::MAX),
+            1 => Vec3::new(3e38, 1.0, 2e37),
+            _ => Vec3::splat(MAX_RADIANCE),
+        })
+        .collect();
+    let env = Environment::from_equirect(width, height, &texels).expect("an environment");
+    assert!(env.irradiance_sh.iter().all(|c| c.is_finite()));
+    for level in &env.levels {
+        assert!(level.texels.iter().flatten().all(|c| c.is_finite()));
+    }
+    let light = EnvironmentLight {
+        environment: Arc::new(env),
+        intensity: 1.0,
+        rotation: 0.0,
+    };
+    let radiance = light.specular(Vec3::new(0.3, 0.5, -0.8), 0.4);
+    assert!(
+        radiance.is_finite() && radiance.max_element() > 1e29,
+        "{radiance}"
+    );
+}
+
 /// Directions spread over the sphere (a Fibonacci spiral), some of them not unit.
 fn spiral(i: usize, n: usize) -> Vec3 {
     let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
