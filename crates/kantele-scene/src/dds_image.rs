@@ -12,11 +12,15 @@
 //!
 //! What is decoded, and how:
 //! - BC1 (`DXT1`), BC2 (`DXT3`), BC3 (`DXT5`) and BC7, as RGBA; BC4 (`ATI1`, `BC4U`, `BC4S`) as
-//!   grey (the one channel in red, green and blue), BC5 (`ATI2`, `BC5U`, `BC5S`) as red and
-//!   green with blue 0 (a two-channel normal map gets no rebuilt Z), unsigned BC6H clamped to
-//!   [0, 1] and truncated to 8 bits (signed BC6H is refused: the decoder reads it as unsigned);
+//!   grey (the one channel in red, green and blue, as a one-channel image reads in OpenGL's
+//!   luminance swizzle, so that occlusion, read from red, and a grey base colour both work),
+//!   BC5 (`ATI2`, `BC5U`, `BC5S`) as the two-channel normal map it is made for: red and green,
+//!   and blue the Z those imply (`z = √(1 − x² − y²)` with `x`, `y` mapped from [0, 1] to
+//!   [−1, 1], as engines reading BC5 normal maps rebuild it), unsigned BC6H clamped to [0, 1]
+//!   and truncated to 8 bits (signed BC6H is refused: the decoder reads it as unsigned);
 //! - 8-bit RGBA and BGRA, legacy (32-bit RGB masks) or DXGI, with alpha or without (`X8`
-//!   formats and legacy files without an alpha mask are opaque).
+//!   formats and legacy files without an alpha mask are opaque); legacy 24-bit RGB and BGR
+//!   (`D3DFMT_R8G8B8`, three bytes a texel, rows unpadded), opaque.
 //!
 //! Cube maps, volume textures and texture arrays are refused with one line naming what they
 //! are, as are other formats (named by their FourCC, D3D or DXGI number) and premultiplied
@@ -92,6 +96,9 @@ struct TexelFormat {
     opaque: bool,
     /// Whether the format says its texels are sRGB-encoded (the `_SRGB` DXGI formats).
     declares_srgb: bool,
+    /// Legacy 24-bit texels (three bytes each, decoded here, not by the decoder): where red,
+    /// green and blue sit in each texel's bytes.
+    packed24: Option<[usize; 3]>,
 }
 
 impl TexelFormat {
@@ -100,6 +107,7 @@ impl TexelFormat {
             format,
             opaque: false,
             declares_srgb: false,
+            packed24: None,
         }
     }
 
@@ -117,11 +125,23 @@ impl TexelFormat {
         }
     }
 
+    /// Legacy 24-bit texels with red, green and blue at byte offsets `order` of each texel.
+    fn packed24(order: [usize; 3]) -> Self {
+        Self {
+            packed24: Some(order),
+            // Decoded here; the decoder's format only names it in messages.
+            ..Self::new(ImageFormat::Rgba8Unorm).opaque()
+        }
+    }
+
     /// Bytes a `width` × `height` level takes in the file: whole 4 × 4 blocks for the BC
-    /// formats, 4 bytes a texel for the uncompressed ones.
+    /// formats, 4 bytes a texel for the uncompressed ones (3 for the 24-bit ones).
     fn level_bytes(self, width: u32, height: u32) -> u64 {
         let (w, h) = (u64::from(width), u64::from(height));
         let blocks = w.div_ceil(4) * h.div_ceil(4);
+        if self.packed24.is_some() {
+            return w * h * 3;
+        }
         match self.format {
             ImageFormat::BC1RgbaUnorm
             | ImageFormat::BC1RgbaUnormSrgb
@@ -205,6 +225,13 @@ impl TexelFormat {
             });
         }
         let [red, green, blue, alpha] = masks;
+        if flags & DDPF_RGB != 0 && bits == 24 {
+            match (red, green, blue) {
+                (0xff_0000, 0xff00, 0xff) => return Ok(Self::packed24([2, 1, 0])),
+                (0xff, 0xff00, 0xff_0000) => return Ok(Self::packed24([0, 1, 2])),
+                _ => {}
+            }
+        }
         if flags & DDPF_RGB != 0 && bits == 32 {
             let format = match (red, green, blue) {
                 (0xff, 0xff00, 0xff_0000) => Some(F::Rgba8Unorm),
@@ -218,7 +245,7 @@ impl TexelFormat {
             }
         }
         Err(decode_error(format!(
-            "DDS uncompressed texels of {bits} bits (flags {flags:#x}, masks R {red:#x} G {green:#x} B {blue:#x} A {alpha:#x}) are not supported (8-bit RGBA / BGRA are)"
+            "DDS uncompressed texels of {bits} bits (flags {flags:#x}, masks R {red:#x} G {green:#x} B {blue:#x} A {alpha:#x}) are not supported (8-bit RGBA / BGRA and 24-bit RGB / BGR are)"
         )))
     }
 }
@@ -373,6 +400,13 @@ impl<'a> DdsFile<'a> {
         let data = self
             .level_data(index)
             .ok_or_else(|| decode_error(format!("the DDS file is truncated in level {index}")))?;
+        if let Some([r, g, b]) = self.texels.packed24 {
+            // `level_data` holds exactly the level's 3 bytes a texel.
+            return Ok(data
+                .chunks_exact(3)
+                .flat_map(|t| [t[r], t[g], t[b], 255])
+                .collect());
+        }
         let surface = image_dds::Surface {
             width,
             height,
@@ -396,8 +430,26 @@ impl<'a> DdsFile<'a> {
                 texel[3] = 255;
             }
         }
+        if matches!(
+            self.texels.format,
+            ImageFormat::BC5RgUnorm | ImageFormat::BC5RgSnorm
+        ) {
+            for texel in rgba.chunks_exact_mut(4) {
+                texel[2] = normal_z(texel[0], texel[1]);
+            }
+        }
         Ok(rgba)
     }
+}
+
+/// The Z byte of a unit normal whose X and Y bytes are `x` and `y` (each mapped from [0, 255]
+/// to [−1, 1]): `√(1 − x² − y²)` (0 where X and Y alone are longer than 1), mapped back and
+/// rounded.
+fn normal_z(x: u8, y: u8) -> u8 {
+    let signed = |byte: u8| f32::from(byte) / 255.0 * 2.0 - 1.0;
+    let (x, y) = (signed(x), signed(y));
+    let z = (1.0 - x * x - y * y).max(0.0).sqrt();
+    ((z * 0.5 + 0.5) * 255.0).round() as u8
 }
 
 /// Runs the decoder with its panics caught: a known way such code fails on corrupt data,
@@ -564,7 +616,31 @@ mod tests {
             .flat_map(|&[r, g, b, a]| [b, g, r, a])
             .collect();
         let opaque = PICTURE.map(|[r, g, b, _]| [r, g, b, 255]).to_vec();
+        let bgr: Vec<u8> = PICTURE.iter().flat_map(|&[r, g, b, _]| [b, g, r]).collect();
+        let rgb: Vec<u8> = PICTURE.iter().flat_map(|&[r, g, b, _]| [r, g, b]).collect();
         let cases = [
+            (
+                "legacy 24-bit BGR",
+                dds(
+                    2,
+                    2,
+                    1,
+                    Pixels::Masks(24, [0xff_0000, 0xff00, 0xff, 0]),
+                    &bgr,
+                ),
+                opaque.clone(),
+            ),
+            (
+                "legacy 24-bit RGB",
+                dds(
+                    2,
+                    2,
+                    1,
+                    Pixels::Masks(24, [0xff, 0xff00, 0xff_0000, 0]),
+                    &rgb,
+                ),
+                opaque.clone(),
+            ),
             (
                 "legacy RGBA",
                 dds(2, 2, 1, Pixels::Masks(32, RGBA_MASKS), &rgba),
@@ -616,6 +692,71 @@ mod tests {
                 assert_eq!(level_texels(&texture, 0), expected, "{name}");
             }
         }
+    }
+
+    /// A 24-bit file's rows are three bytes a texel, unpadded, level after level: a file of
+    /// three levels one byte short of the last is read from level 0 alone.
+    #[test]
+    fn a_24_bit_chain_is_read_level_by_level() {
+        let level = |[r, g, b]: [u8; 3], texels: usize| [b, g, r].repeat(texels);
+        // 4 × 3, 2 × 1, 1 × 1.
+        let chain = [
+            level([200, 10, 0], 12),
+            level([0, 200, 10], 2),
+            level([5, 6, 7], 1),
+        ];
+        let masks = [0xff_0000, 0xff00, 0xff, 0];
+        let file = dds(4, 3, 3, Pixels::Masks(24, masks), &chain.concat());
+        let texture = decode(&file, ColorSpace::Linear).expect("a 24-bit chain");
+        assert_eq!(level_texels(&texture, 1), vec![[0, 200, 10, 255]; 2]);
+        assert_eq!(level_texels(&texture, 2), vec![[5, 6, 7, 255]]);
+        let short = &file[..file.len() - 1];
+        let texture = decode(short, ColorSpace::Linear).expect("level 0 alone");
+        assert_eq!(level_texels(&texture, 0), vec![[200, 10, 0, 255]; 12]);
+        // Other 24-bit layouts are refused, naming what is read.
+        let other = dds(
+            4,
+            3,
+            1,
+            Pixels::Masks(24, [0xff00, 0xff, 0xff_0000, 0]),
+            &chain[0],
+        );
+        let e = decode(&other, ColorSpace::Linear).unwrap_err();
+        assert!(
+            e.contains("24 bits") && e.contains("24-bit RGB / BGR are"),
+            "{e}"
+        );
+    }
+
+    /// BC5 holds a normal map's X and Y: Z is rebuilt from them, the normal's length 1.
+    #[test]
+    fn bc5_normal_maps_get_their_z() {
+        // One BC5 block per channel pair: endpoints (r0, r1) with every index 0 (texel = r0).
+        let channel = |value: u8| [value, 0, 0, 0, 0, 0, 0, 0];
+        for (x, y) in [(128u8, 128u8), (255, 128), (180, 60), (0, 0)] {
+            let block = [channel(x), channel(y)].concat();
+            for code in [b"ATI2", b"BC5U"] {
+                let file = dds(4, 4, 1, Pixels::FourCc(code), &block);
+                let texture = decode(&file, ColorSpace::Linear).expect("BC5");
+                let [r, g, b, a] = level_texels(&texture, 0)[5];
+                assert_eq!([r, g, a], [x, y, 255]);
+                let unit = |v: u8| f32::from(v) / 255.0 * 2.0 - 1.0;
+                let length2 = unit(r).powi(2) + unit(g).powi(2) + unit(b).powi(2);
+                if length2 > 1.0 + 0.02 {
+                    // X and Y alone longer than 1: Z is 0 (the middle byte).
+                    assert!(
+                        unit(r).powi(2) + unit(g).powi(2) > 1.0 && b == 128,
+                        "{x} {y}: {b}"
+                    );
+                } else {
+                    assert!(
+                        (length2 - 1.0).abs() < 0.02,
+                        "{x} {y}: z {b}, |n|² {length2}"
+                    );
+                }
+            }
+        }
+        assert_eq!(normal_z(128, 128), 255);
     }
 
     #[test]
