@@ -477,7 +477,6 @@ impl PbrShader<'_> {
                 metallic = metallic * texel[2];
                 roughness = roughness * texel[1];
             }
-            let clamp = |x: L::F32| clamp01(lanes, x);
             let mut occlusion = one;
             if self.textures.occlusion.is_some() {
                 let texel = texels[OCCLUSION];
@@ -510,8 +509,8 @@ impl PbrShader<'_> {
                     roughness = roughness * texels[CLEARCOAT_ROUGHNESS][1];
                 }
                 Some(ClearcoatLayer {
-                    factor: clamp(factor),
-                    roughness: clamp(roughness),
+                    factor: clamp01(lanes, factor),
+                    roughness: clamp01(lanes, roughness),
                     normal: coat_normal,
                 })
             } else {
@@ -519,8 +518,8 @@ impl PbrShader<'_> {
             };
             let surface = Surface {
                 base: [base[0], base[1], base[2]],
-                metallic: clamp(metallic),
-                roughness: clamp(roughness),
+                metallic: clamp01(lanes, metallic),
+                roughness: clamp01(lanes, roughness),
                 occlusion,
                 normal,
                 position: [
@@ -533,7 +532,7 @@ impl PbrShader<'_> {
                     dielectric_f0[1].min(one),
                     dielectric_f0[2].min(one),
                 ],
-                specular_weight: clamp(specular_weight),
+                specular_weight: clamp01(lanes, specular_weight),
                 clearcoat,
             };
             pbr::shade(lanes, self.lighting, &surface, &emissive)

@@ -240,18 +240,11 @@ impl EnvironmentLight {
 /// cell's centre and the right cell's weight is 0 (every cell is finite).
 #[inline(always)]
 pub fn brdf_ab_lanes<L: Lanes>(lanes: L, n_dot_v: L::F32, roughness: L::F32) -> [L::F32; 2] {
-    let n = BRDF_TABLE_SIZE as f32;
-    let (zero, one) = (lanes.splat_f32(0.0), lanes.splat_f32(1.0));
-    let coordinate = |v: L::F32| {
-        let v = v
-            .abs()
-            .simd_lt(lanes.splat_f32(f32::INFINITY))
-            .select_f32(v, one);
-        (v * lanes.splat_f32(n) - lanes.splat_f32(0.5))
-            .max(zero)
-            .min(lanes.splat_f32(n - 1.0))
-    };
-    let (x, y) = (coordinate(n_dot_v), coordinate(roughness));
+    let zero = lanes.splat_f32(0.0);
+    let (x, y) = (
+        brdf_coordinate(lanes, n_dot_v),
+        brdf_coordinate(lanes, roughness),
+    );
     let (x0, y0) = (x.floor(), y.floor());
     let (fx, fy) = (x - x0, y - y0);
     let (x0, y0) = (x0.to_i32_trunc(), y0.to_i32_trunc());
@@ -260,9 +253,8 @@ pub fn brdf_ab_lanes<L: Lanes>(lanes: L, n_dot_v: L::F32, roughness: L::F32) -> 
     let size = lanes.splat_i32(BRDF_TABLE_SIZE as i32);
     let table = brdf_table_bits();
     // Cell (x, y) holds A at 2 (y size + x) and B after it: [A, B, A, B] of a row's two cells.
-    let cell = |y: L::I32| (y * size + x0).shl::<1>();
-    let top = cell(y0).gather_u32_quad(table);
-    let bottom = cell(y1).gather_u32_quad(table);
+    let top = (y0 * size + x0).shl::<1>().gather_u32_quad(table);
+    let bottom = (y1 * size + x0).shl::<1>().gather_u32_quad(table);
     let mut out = [zero; 2];
     for (c, o) in out.iter_mut().enumerate() {
         let t = [
@@ -276,6 +268,22 @@ pub fn brdf_ab_lanes<L: Lanes>(lanes: L, n_dot_v: L::F32, roughness: L::F32) -> 
         *o = top + (bottom - top) * fy;
     }
     out
+}
+
+/// A split-sum table coordinate in cells, per lane: `v × size − ½` clamped to the cell centres
+/// `[0, size − 1]` (a non-finite `v` reads as 1). A function, not a closure: LLVM may compile
+/// a closure's body out of line, without the kernel's instruction set, and then each lane
+/// operation in it is a call.
+#[inline(always)]
+fn brdf_coordinate<L: Lanes>(lanes: L, v: L::F32) -> L::F32 {
+    let n = BRDF_TABLE_SIZE as f32;
+    let v = v
+        .abs()
+        .simd_lt(lanes.splat_f32(f32::INFINITY))
+        .select_f32(v, lanes.splat_f32(1.0));
+    (v * lanes.splat_f32(n) - lanes.splat_f32(0.5))
+        .max(lanes.splat_f32(0.0))
+        .min(lanes.splat_f32(n - 1.0))
 }
 
 /// `v / |v|` per lane, or 0 where that is not finite or not positive (glam's
@@ -308,10 +316,13 @@ fn octahedral_encode_lanes<L: Lanes>(lanes: L, d: &[L::F32; 3]) -> [L::F32; 2] {
     let positive = sum.simd_gt(zero);
     let px = positive.select_f32(d[0] / sum, zero);
     let py = positive.select_f32(d[1] / sum, zero);
-    let sign = |v: L::F32| v.simd_ge(zero).select_f32(one, -one);
+    let (sign_x, sign_y) = (
+        px.simd_ge(zero).select_f32(one, -one),
+        py.simd_ge(zero).select_f32(one, -one),
+    );
     let below = d[2].simd_lt(zero);
-    let fx = below.select_f32((one - py.abs()) * sign(px), px);
-    let fy = below.select_f32((one - px.abs()) * sign(py), py);
+    let fx = below.select_f32((one - py.abs()) * sign_x, px);
+    let fy = below.select_f32((one - px.abs()) * sign_y, py);
     [fx * half + half, fy * half + half]
 }
 
@@ -345,8 +356,8 @@ fn sample_level_lanes<L: Lanes>(
     let edge = stride - lanes.splat_i32(1);
     let y1 = (y0 + lanes.splat_i32(1)).min(edge);
     // Word index of a row's left texel; its right texel follows four words on.
-    let texel = |y: L::I32| (first + y * stride + x0).shl::<2>();
-    let (top, bottom) = (texel(y0), texel(y1));
+    let top = (first + y0 * stride + x0).shl::<2>();
+    let bottom = (first + y1 * stride + x0).shl::<2>();
     let right = lanes.splat_i32(4);
     let [top_left, top_right, bottom_left, bottom_right] = [
         top.gather_u32_quad(table),

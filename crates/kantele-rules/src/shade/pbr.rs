@@ -551,17 +551,23 @@ pub fn tonemap<L: Lanes>(
     match tonemap {
         Tonemap::None => rgb,
         Tonemap::PbrNeutral => pbr_neutral(lanes, rgb),
-        Tonemap::Aces => {
-            let f = |x: L::F32| {
-                let x = x.max(lanes.splat_f32(0.0));
-                let num = x * (lanes.splat_f32(2.51) * x + lanes.splat_f32(0.03));
-                let den =
-                    x * (lanes.splat_f32(2.43) * x + lanes.splat_f32(0.59)) + lanes.splat_f32(0.14);
-                clamp01(lanes, num / den)
-            };
-            [f(rgb[0]), f(rgb[1]), f(rgb[2])]
-        }
+        Tonemap::Aces => [
+            aces(lanes, rgb[0]),
+            aces(lanes, rgb[1]),
+            aces(lanes, rgb[2]),
+        ],
     }
+}
+
+/// The ACES filmic curve as fitted by Krzysztof Narkowicz, per lane: `x (2.51 x + 0.03) /
+/// (x (2.43 x + 0.59) + 0.14)` of `max(x, 0)`, clamped to [0, 1]. A function, not a closure:
+/// LLVM may compile a closure's body out of line, without the kernel's instruction set.
+#[inline(always)]
+fn aces<L: Lanes>(lanes: L, x: L::F32) -> L::F32 {
+    let x = x.max(lanes.splat_f32(0.0));
+    let num = x * (lanes.splat_f32(2.51) * x + lanes.splat_f32(0.03));
+    let den = x * (lanes.splat_f32(2.43) * x + lanes.splat_f32(0.59)) + lanes.splat_f32(0.14);
+    clamp01(lanes, num / den)
 }
 
 /// Khronos PBR Neutral: peak values from here on are compressed towards white.
