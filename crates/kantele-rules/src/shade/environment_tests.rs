@@ -3,6 +3,7 @@
 use glam::{Vec2, Vec3};
 use kantele_lanes::{dispatch, Isa, LaneKernel};
 
+use super::prepare::{equirect_direction, with_border};
 use super::*;
 
 /// Octahedral encoding and decoding are inverse, and the border repeats the texel across
