@@ -18,6 +18,8 @@ use std::sync::{Arc, OnceLock};
 use glam::{Vec2, Vec3};
 use kantele_lanes::{F32x8, I32x8, Lanes, Mask8, Scalar, TexelGather};
 
+use super::levels::{lane_table, lookup16, LaneTable};
+
 #[path = "environment_prepare.rs"]
 mod prepare;
 pub use prepare::brdf_table;
@@ -343,10 +345,11 @@ fn sample_level_lanes<L: Lanes>(
     uv: &[L::F32; 2],
 ) -> [L::F32; 3] {
     let zero = lanes.splat_f32(0.0);
-    let size_i = level_entry::<L>(lanes, &LANE_LEVEL_SIZES, level);
+    let [lane_sizes, lane_offsets] = &LANE_LEVEL_TABLES;
+    let size_i = lookup16::<L>(lane_sizes, level);
     let size = size_i.to_f32();
     let stride = size_i + lanes.splat_i32(2);
-    let first = level_entry::<L>(lanes, &LANE_LEVEL_OFFSETS, level);
+    let first = lookup16::<L>(lane_offsets, level);
     let half = lanes.splat_f32(0.5);
     let limit = size + lanes.splat_f32(1.0);
     // Texel centre i sits at (i + 0.5) / size; the border shifts indices by one.
@@ -382,29 +385,9 @@ fn sample_level_lanes<L: Lanes>(
     out
 }
 
-/// Lane `k`: `table[level[k]]`, for levels in `0..SPECULAR_LEVELS` (one permute, no gather).
-#[inline(always)]
-fn level_entry<L: Lanes>(lanes: L, table: &[i32; 8], level: L::I32) -> L::I32 {
-    L::F32::from_bits(lanes.load_i32(table))
-        .permute(level)
-        .to_bits()
-}
-
-/// [`LEVEL_SIZES`] as eight lanes, for [`level_entry`].
-const LANE_LEVEL_SIZES: [i32; 8] = lane_table(LEVEL_SIZES);
-
-/// [`LEVEL_OFFSETS`] as eight lanes, for [`level_entry`].
-const LANE_LEVEL_OFFSETS: [i32; 8] = lane_table(LEVEL_OFFSETS);
-
-const fn lane_table(values: [u32; SPECULAR_LEVELS]) -> [i32; 8] {
-    let mut out = [0; 8];
-    let mut k = 0;
-    while k < SPECULAR_LEVELS {
-        out[k] = values[k] as i32;
-        k += 1;
-    }
-    out
-}
+/// [`LEVEL_SIZES`] and [`LEVEL_OFFSETS`] as [`LaneTable`]s, the form the lane lookups read
+/// per-level values in (as the texture sampler reads its mip levels').
+const LANE_LEVEL_TABLES: [LaneTable; 2] = [lane_table(&LEVEL_SIZES), lane_table(&LEVEL_OFFSETS)];
 
 /// Where each specular level's texels start in [`Environment::texel_bits`], in texels.
 const LEVEL_OFFSETS: [u32; SPECULAR_LEVELS] = {

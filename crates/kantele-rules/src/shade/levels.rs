@@ -1,6 +1,8 @@
 //! Where each level of a texture's mip chain lies: a [`LevelTable`] of offsets and sizes, and
 //! the same values as [`LaneTable`]s, the form the lane-wide sampler looks them up in.
 
+use kantele_lanes::{F32x8, I32x8, Lanes, Mask8};
+
 use crate::state::MAX_TEXTURE_SIZE;
 
 /// Where each mip level lies in the texel storage, one entry per level (level 0 first), and
@@ -52,10 +54,36 @@ const _: () = assert!(
 
 /// `values` (one per level, at most 16, each below 2³¹: offsets of at most 16384² · 4/3
 /// texels, sizes of at most 16384) as a [`LaneTable`].
-pub(super) fn lane_table(values: &[u32]) -> LaneTable {
-    let last = values.last().copied().unwrap_or(0);
-    std::array::from_fn(|k| {
-        let value = values.get(k).copied().unwrap_or(last);
-        i32::try_from(value).unwrap_or(i32::MAX)
-    })
+/// A `const fn`, so that fixed chains (the environment's specular levels) have their tables as
+/// constants.
+pub(super) const fn lane_table(values: &[u32]) -> LaneTable {
+    let mut table = [0; 16];
+    let mut k = 0;
+    while k < 16 {
+        let value = if k < values.len() {
+            values[k]
+        } else if values.is_empty() {
+            0
+        } else {
+            values[values.len() - 1]
+        };
+        table[k] = if value > i32::MAX as u32 {
+            i32::MAX
+        } else {
+            value as i32
+        };
+        k += 1;
+    }
+    table
+}
+
+/// Lane `k`: `table[index[k] mod 16]`, without a branch or a memory access per lane (two
+/// permutes of eight entries and a select; the values move as bits).
+#[inline(always)]
+pub(super) fn lookup16<L: Lanes>(table: &LaneTable, index: L::I32) -> L::I32 {
+    let lanes = index.lanes();
+    let low = L::F32::from_bits(lanes.load_i32(&table[..8])).permute(index);
+    let high = L::F32::from_bits(lanes.load_i32(&table[8..])).permute(index);
+    let in_high = (index & lanes.splat_i32(8)).simd_eq(lanes.splat_i32(8));
+    in_high.select_f32(high, low).to_bits()
 }

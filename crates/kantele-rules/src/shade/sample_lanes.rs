@@ -26,7 +26,7 @@ use kantele_lanes::{
     bilinear15, lerp15_channels, F32x8, Footprint15, I32x8, Lanes, Mask8, MaskOf, TexelGather,
 };
 
-use super::levels::LaneTable;
+use super::levels::{lookup16, LaneTable};
 use super::texel::{linear15_table, LINEAR15_SCALE};
 use super::texel_lanes::{Channels, TexelSource};
 use super::texture::{ColorSpace, Filter, Linear15Copy, MinFilter, Sampler, Texture, Wrap};
@@ -359,17 +359,6 @@ fn lod_lanes<L: Lanes>(sizes: Sizes, rho2: L::F32) -> L::F32 {
         lanes.splat_f32(sizes.max_level),
     );
     normal.select_f32(lod, fallback)
-}
-
-/// Lane `k`: `table[index[k] mod 16]`, without a branch or a memory access per lane (two
-/// permutes of eight entries and a select; the values move as bits).
-#[inline(always)]
-fn lookup16<L: Lanes>(table: &LaneTable, index: L::I32) -> L::I32 {
-    let lanes = index.lanes();
-    let low = L::F32::from_bits(lanes.load_i32(&table[..8])).permute(index);
-    let high = L::F32::from_bits(lanes.load_i32(&table[8..])).permute(index);
-    let in_high = (index & lanes.splat_i32(8)).simd_eq(lanes.splat_i32(8));
-    in_high.select_f32(high, low).to_bits()
 }
 
 /// Where a texel source holds each level: the index of its first texel, and rows of `width +
