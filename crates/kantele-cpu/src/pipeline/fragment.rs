@@ -233,9 +233,9 @@ impl<S: Shader> LaneProgramJob for ShadeTriangleJob<'_, '_, S> {
     }
 }
 
-/// Whether `state` is the common opaque state that the per-pixel kernels (1× and multisampled)
-/// compile or run a path of their own for: depth test LESS with depth writes, no blending.
-pub(super) fn is_opaque_less(state: &RenderState) -> bool {
+/// Whether `state` is the common opaque state that the 1× kernels are compiled once more for:
+/// depth test LESS with depth writes, no blending.
+fn is_opaque_less(state: &RenderState) -> bool {
     state.depth_test
         && state.depth_func == DepthFunc::Less
         && state.depth_write
@@ -543,7 +543,8 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
             }
             let calls = if pack { count.div_ceil(8) } else { 8 };
             for call in 0..calls {
-                // The fragments of this call: a packed group, or a row.
+                // The fragments of this call: a packed group, or the row at `at`.
+                let at = BlockRows::row_offset(call);
                 let (active, depth, bary, y) = if pack {
                     let group = 8 * call;
                     let active =
@@ -551,9 +552,8 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
                     let (bary, depth) = packed.group(lanes, group, one);
                     (active, depth, bary, block.y)
                 } else {
-                    let (row, at) = (call, BlockRows::row_offset(call));
-                    let row_bits = (block.mask >> (8 * row)) as u8;
-                    let y = block.y + row as i32;
+                    let row_bits = (block.mask >> (8 * call)) as u8;
+                    let y = block.y + call as i32;
                     // No closure around lane code here: LLVM may compile its body out of line,
                     // without the kernel's instruction set.
                     let mut active = lanes.mask_all(false);
@@ -583,7 +583,6 @@ impl<S: Shader, P: LaneProgram, const OPAQUE_LESS: bool, const CONSTANT: bool> L
                     packed.store_shaded::<L>(8 * call, shaded.color, keep, [zero, one]);
                     continue;
                 }
-                let at = BlockRows::row_offset(call);
                 shaded_bits |= (active.bits() as u64) << (8 * call);
                 kept_bits |= (keep.bits() as u64) << (8 * call);
                 let written = rules

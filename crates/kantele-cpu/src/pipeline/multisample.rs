@@ -18,7 +18,7 @@
 use super::budget::{FrameBudget, TRIANGLES_PER_CHECK};
 use super::call::DrawCall;
 use super::fragment::{
-    binned_triangles, is_opaque_less, RasterCounters, RasterJob, TriangleLanes, TILES_PER_PIECE,
+    binned_triangles, RasterCounters, RasterJob, TriangleLanes, TILES_PER_PIECE,
 };
 use super::geometry::GeometryOutput;
 use super::sanitize::zero_nan_channels;
@@ -30,7 +30,7 @@ use super::shading_isas::dispatch_shading;
 use crate::raster::bin::TileBins;
 use crate::raster::samples::{rasterize_samples, SampleCoverage, MAX_COVERAGE_PLANES};
 use crate::raster::Strategy;
-use crate::rop::{Framebuffer, TileBuffer};
+use crate::rop::{BlendMode, DepthFunc, Framebuffer, TileBuffer};
 use kantele_lanes::{F32x8, Isa, LaneKernel, Lanes, Mask8};
 use kantele_rules::fixed::{pixel_center, BLOCK_SIZE, TILE_SIZE};
 use kantele_rules::setup::TriangleSetup;
@@ -131,19 +131,17 @@ impl<S: Shader> LaneProgramJob for ShadeSamplesJob<'_, '_, S> {
                 attrs: self.attrs,
                 coverage: self.coverage,
                 tile: self.tile,
-                opaque_less: is_opaque_less(&self.draw.state),
             },
         )
     }
 }
 
 /// One triangle in one multisampled tile, as a kernel compiled per instruction set and lane
-/// program. For the commonest state (`opaque_less`: depth test LESS, depth write, Replace) it
-/// tests depth directly and writes the shaded colour without reading the samples' colours (what
-/// blending with Replace would give, bit for bit). That is a branch per row, not a kernel of its
-/// own: a second kernel per lane program cost build time and memory (the largest part of the
-/// renderer's compile) and gave no measurable speed, the shading program dominating a
-/// multisampled row.
+/// program. A LESS depth test is compared directly, and Replace writes the shaded colour
+/// without reading the samples' colours (what blending with Replace would give, bit for bit):
+/// branches on the draw's state, not kernels of their own. A kernel per state class cost build
+/// time and memory (the largest part of the renderer's compile) and gave no measurable speed,
+/// the shading program dominating a multisampled row.
 struct ShadeSamples<'k, 'a, S: Shader, P: LaneProgram> {
     draw: &'k DrawCall<'a, S>,
     program: &'k P,
@@ -151,8 +149,6 @@ struct ShadeSamples<'k, 'a, S: Shader, P: LaneProgram> {
     attrs: &'k [f32],
     coverage: &'k SampleCoverage,
     tile: &'k mut TileBuffer,
-    /// The draw's state is [`is_opaque_less`].
-    opaque_less: bool,
 }
 
 impl<S: Shader, P: LaneProgram> LaneKernel for ShadeSamples<'_, '_, S, P> {
@@ -167,7 +163,6 @@ impl<S: Shader, P: LaneProgram> LaneKernel for ShadeSamples<'_, '_, S, P> {
             attrs,
             coverage,
             tile,
-            opaque_less,
         } = self;
         let state = &draw.state;
         let shader = draw.shader;
@@ -194,8 +189,9 @@ impl<S: Shader, P: LaneProgram> LaneKernel for ShadeSamples<'_, '_, S, P> {
         // within [0, 1] when that range is, so the range test is needed only otherwise (a NaN
         // bound fails the comparison and keeps the test), as in the 1× path.
         let depth_needs_range_test = !(tri.depth_range[0] >= 0.0 && tri.depth_range[1] <= 1.0);
-        let depth_test = opaque_less || state.depth_test;
-        let depth_write = opaque_less || state.depth_write;
+        let (depth_test, depth_write) = (state.depth_test, state.depth_write);
+        let depth_less = state.depth_func == DepthFunc::Less;
+        let replace = state.blend == BlendMode::Replace;
 
         for block in coverage.blocks() {
             if blocks_can_reject && tile.block_occludes(block.index, tri.depth_range[0]) {
@@ -241,7 +237,7 @@ impl<S: Shader, P: LaneProgram> LaneKernel for ShadeSamples<'_, '_, S, P> {
                     }
                     if depth_test {
                         let stored = lanes.load_f32(tile.depth_plane_row(plane, index));
-                        let passes = if opaque_less {
+                        let passes = if depth_less {
                             depth.simd_lt(stored)
                         } else {
                             state.depth_func.passes_lanes(lanes, depth, stored)
@@ -285,7 +281,7 @@ impl<S: Shader, P: LaneProgram> LaneKernel for ShadeSamples<'_, '_, S, P> {
                     if keep_sample.none() {
                         continue;
                     }
-                    let blended = if opaque_less {
+                    let blended = if replace {
                         // Replace: the sanitised source, as `blend_lanes` would return it.
                         src
                     } else {
