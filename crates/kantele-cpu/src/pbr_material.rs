@@ -534,6 +534,7 @@ impl PbrShader<'_> {
                 ],
                 specular_weight: clamp01(lanes, specular_weight),
                 clearcoat,
+                transmission: None,
             };
             pbr::shade(lanes, self.lighting, &surface, &emissive)
         };

@@ -93,6 +93,7 @@ fn lighting(environment: bool) -> PbrLighting {
         eye: Vec3::new(0.0, 0.0, 3.0),
         exposure: 1.0,
         tonemap: Tonemap::PbrNeutral,
+        transmission: None,
     }
 }
 

@@ -243,7 +243,8 @@ impl GlBackend {
             0,
             0,
         ];
-        for (k, binding) in material.pbr_textures().into_iter().enumerate() {
+        // The shader reads the first eight (not yet transmission and thickness).
+        for (k, binding) in material.pbr_textures().into_iter().take(8).enumerate() {
             sets[2 + k] = set(binding);
         }
         let coat_normal = material

@@ -210,6 +210,24 @@ pub struct Material {
     pub clearcoat_normal_texture: Option<TextureBinding>,
     /// Scales the coat normal texture's X and Y.
     pub clearcoat_normal_scale: f32,
+    /// Index of refraction of the dielectric part (`KHR_materials_ior`; 1.5 without it): bends
+    /// the light a volume transmits and widens rough transmission.
+    pub ior: f32,
+    /// `transmissionFactor`: the part of the dielectric's diffuse light replaced by light from
+    /// behind the surface (`KHR_materials_transmission`; 0 without it: opaque).
+    pub transmission: f32,
+    /// Linear texture whose red channel multiplies `transmission`.
+    pub transmission_texture: Option<TextureBinding>,
+    /// `thicknessFactor`: the volume's thickness under the surface, in the mesh's units
+    /// (`KHR_materials_volume`; 0: thin-walled, no refraction).
+    pub thickness: f32,
+    /// Linear texture whose green channel multiplies `thickness`.
+    pub thickness_texture: Option<TextureBinding>,
+    /// `attenuationColor`: the colour white light becomes after `attenuation_distance` inside
+    /// the volume (linear RGB in [0, 1]).
+    pub attenuation_color: Vec3,
+    /// `attenuationDistance` in world units; infinite: no attenuation.
+    pub attenuation_distance: f32,
 }
 
 impl Default for Material {
@@ -240,6 +258,13 @@ impl Default for Material {
             clearcoat_roughness_texture: None,
             clearcoat_normal_texture: None,
             clearcoat_normal_scale: 1.0,
+            ior: 1.5,
+            transmission: 0.0,
+            transmission_texture: None,
+            thickness: 0.0,
+            thickness_texture: None,
+            attenuation_color: Vec3::ONE,
+            attenuation_distance: f32::INFINITY,
         }
     }
 }
@@ -247,8 +272,8 @@ impl Default for Material {
 impl Material {
     /// The material's textures that PBR shading reads besides the base colour and emissive
     /// ones: metallic-roughness, normal, occlusion, specular, specular colour, clear coat,
-    /// clear-coat roughness and clear-coat normal.
-    pub fn pbr_textures(&self) -> [Option<TextureBinding>; 8] {
+    /// clear-coat roughness, clear-coat normal, transmission and thickness.
+    pub fn pbr_textures(&self) -> [Option<TextureBinding>; 10] {
         [
             self.metallic_roughness_texture,
             self.normal_texture,
@@ -258,12 +283,19 @@ impl Material {
             self.clearcoat_texture,
             self.clearcoat_roughness_texture,
             self.clearcoat_normal_texture,
+            self.transmission_texture,
+            self.thickness_texture,
         ]
     }
 
     /// Whether the material has a clear coat (`clearcoat > 0`).
     pub fn has_clearcoat(&self) -> bool {
         self.clearcoat > 0.0
+    }
+
+    /// Whether light from behind shows through the material (`transmission > 0`).
+    pub fn has_transmission(&self) -> bool {
+        self.transmission > 0.0
     }
 }
 

@@ -8,3 +8,4 @@ pub mod spec_gloss;
 pub mod texel;
 mod texel_lanes;
 pub mod texture;
+pub mod transmission;

@@ -1,8 +1,9 @@
 //! glTF 2.0's physically based shading, written once for every backend: the metallic-roughness
 //! BRDF of the specification's Appendix B (GGX distribution, Smith height-correlated
 //! visibility, Schlick Fresnel, the metal / dielectric mix), with the dielectric reflectance of
-//! `KHR_materials_ior` and `KHR_materials_specular` and the coat of `KHR_materials_clearcoat`;
-//! the `KHR_lights_punctual` falloff, image-based light through an [`EnvironmentLight`],
+//! `KHR_materials_ior` and `KHR_materials_specular`, the coat of `KHR_materials_clearcoat`
+//! and the transmission of `KHR_materials_transmission` and `KHR_materials_volume`
+//! ([`super::transmission`]); the `KHR_lights_punctual` falloff, image-based light through an [`EnvironmentLight`],
 //! exposure and tone mapping.
 //!
 //! The functions are generic over [`Lanes`]: the CPU backend runs them on eight pixels at once,
@@ -13,7 +14,8 @@
 use glam::Vec3;
 use kantele_lanes::{F32x8, Lanes, Mask8};
 
-use super::environment::EnvironmentLight;
+use super::environment::{brdf_ab_lanes, EnvironmentLight};
+use super::transmission::{attenuate, transmitted_light, TransmissionLayer, TransmissionView};
 use crate::scene::{LightKind, PunctualLight};
 
 /// Reflectance at normal incidence of every dielectric (glTF: IOR 1.5).
@@ -150,6 +152,9 @@ pub struct Surface<L: Lanes> {
     pub specular_weight: L::F32,
     /// The clear coat, where the material has one.
     pub clearcoat: Option<ClearcoatLayer<L>>,
+    /// The transmission, where the material has one and the frame a backdrop
+    /// ([`PbrLighting::transmission`]).
+    pub transmission: Option<TransmissionLayer<L>>,
 }
 
 /// `KHR_materials_clearcoat`'s layer over a surface point, per lane: a dielectric (F0 =
@@ -179,6 +184,9 @@ pub struct PbrLighting {
     pub exposure: f32,
     /// The tone map.
     pub tonemap: Tonemap,
+    /// What transmissive surfaces see through: set by a backend once it has drawn the frame's
+    /// backdrop ([`super::transmission`]); `None` from [`PbrLighting::for_frame`].
+    pub transmission: Option<TransmissionView>,
 }
 
 /// The most punctual lights a PBR frame shades with (the OpenGL shader's array size); loaders
@@ -205,6 +213,7 @@ impl PbrLighting {
             eye: view.view.inverse().transform_point3(Vec3::ZERO),
             exposure: exposure_scale(scene.exposure),
             tonemap: scene.tonemap,
+            transmission: None,
         }
     }
 }
@@ -394,6 +403,7 @@ fn punctual<L: Lanes>(
     view: &[L::F32; 3],
     r: &Reflectance<L>,
     alpha: L::F32,
+    path: &[L::F32; 3],
 ) -> ([L::F32; 3], [L::F32; 3]) {
     let (l, attenuation) = light_arrival(lanes, light, &s.position);
     let h = normalize3(lanes, [view[0] + l[0], view[1] + l[1], view[2] + l[2]]);
@@ -408,9 +418,19 @@ fn punctual<L: Lanes>(
     let scale = attenuation * n_dot_l;
     let mut out = [lanes.splat_f32(0.0); 3];
     let color = light.color.to_array();
-    for c in 0..3 {
-        let brdf = (one - f[c]) * r.c_diff[c] * inv_pi + f[c] * dv;
-        out[c] = lanes.splat_f32(color[c]) * scale * brdf;
+    if let Some(layer) = &s.transmission {
+        // Transmission takes its part of the diffuse light, and adds the light from behind.
+        let through = punctual_transmission(lanes, light, s, layer, view, r, alpha, path);
+        let kept = one - layer.factor;
+        for c in 0..3 {
+            let brdf = (one - f[c]) * r.c_diff[c] * inv_pi * kept + f[c] * dv;
+            out[c] = lanes.splat_f32(color[c]) * scale * brdf + through[c];
+        }
+    } else {
+        for c in 0..3 {
+            let brdf = (one - f[c]) * r.c_diff[c] * inv_pi + f[c] * dv;
+            out[c] = lanes.splat_f32(color[c]) * scale * brdf;
+        }
     }
     let mut coat = [lanes.splat_f32(0.0); 3];
     if let Some(layer) = &s.clearcoat {
@@ -428,12 +448,80 @@ fn punctual<L: Lanes>(
     (out, coat)
 }
 
+/// The light of one punctual light that a transmissive surface point lets through towards
+/// `view`: the GGX lobe around the light's direction mirrored in the surface's plane
+/// (`radiance × NdotL_mirrored × (1 − F) × c_diff × D V`, at `α × clamp(2 ior − 2, 0, 1)`, no
+/// narrower than the punctual lights' floor), × the transmission factor, with the light's
+/// falloff taken where the refracted view ray leaves the volume and dimmed along that path.
+/// The glTF sample viewer's lobe, with the cosine factor that the rendering equation gives
+/// every lobe.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn punctual_transmission<L: Lanes>(
+    lanes: L,
+    light: &FrameLight,
+    s: &Surface<L>,
+    layer: &TransmissionLayer<L>,
+    view: &[L::F32; 3],
+    r: &Reflectance<L>,
+    alpha: L::F32,
+    path: &[L::F32; 3],
+) -> [L::F32; 3] {
+    let one = lanes.splat_f32(1.0);
+    let n = &s.normal;
+    let exit = [
+        s.position[0] + path[0],
+        s.position[1] + path[1],
+        s.position[2] + path[2],
+    ];
+    let (l, attenuation) = light_arrival(lanes, light, &exit);
+    // The light's direction mirrored in the surface's plane: L − 2 (N·L) N.
+    let n_dot_l = dot3::<L>(n, &l);
+    let twice = n_dot_l + n_dot_l;
+    let mirrored = normalize3(
+        lanes,
+        [
+            l[0] - twice * n[0],
+            l[1] - twice * n[1],
+            l[2] - twice * n[2],
+        ],
+    );
+    let h = normalize3(
+        lanes,
+        [
+            view[0] + mirrored[0],
+            view[1] + mirrored[1],
+            view[2] + mirrored[2],
+        ],
+    );
+    let n_dot_m = clamp01(lanes, dot3::<L>(n, &mirrored));
+    let n_dot_v = clamp01(lanes, dot3::<L>(n, view));
+    let n_dot_h = clamp01(lanes, dot3::<L>(n, &h));
+    let v_dot_h = clamp01(lanes, dot3::<L>(view, &h));
+    let floor = MIN_PUNCTUAL_ROUGHNESS * MIN_PUNCTUAL_ROUGHNESS;
+    let ior_scale = (2.0 * layer.volume.ior - 2.0).clamp(0.0, 1.0);
+    let alpha_t = (alpha * lanes.splat_f32(ior_scale)).max(lanes.splat_f32(floor));
+    let dv = ggx_d_times_v(lanes, alpha_t, n_dot_m, n_dot_v, n_dot_h);
+    let f = schlick(lanes, &r.f0, r.f90, v_dot_h);
+    let weight = attenuation * n_dot_m * dv * layer.factor;
+    let color = light.color.to_array();
+    let mut out = [lanes.splat_f32(0.0); 3];
+    for c in 0..3 {
+        out[c] = lanes.splat_f32(color[c]) * weight * (one - f[c]) * r.c_diff[c];
+    }
+    attenuate(lanes, &layer.volume, path, out)
+}
+
 /// The linear colour of a lit surface point emitting `emissive`, before exposure and tone
 /// mapping: every punctual light by Appendix B (`punctual`), plus image-based light (diffuse
 /// irradiance × `c_diff × (1 − FssEss)` and the pre-filtered specular radiance × `FssEss = F0 A
 /// + F90 B`, both × occlusion), where `A`, `B` are the split-sum terms of the environment's
 /// BRDF table; plus the emission. With a clear coat of weight `k` (`KHR_materials_clearcoat`)
 /// that sum is scaled by `1 − k F_coat(N_coat·V)` and the coat's own lobe, × `k`, is added.
+/// With transmission of weight `t` (a [`TransmissionLayer`] and a frame's
+/// [`TransmissionView`]), `t` of the diffuse light (image-based and punctual) is replaced by
+/// light from behind: the backdrop's ([`transmitted_light`]) × `c_diff × (1 − FssEss)`, and
+/// each punctual light's transmitted lobe.
 #[inline(always)]
 pub fn shade<L: Lanes>(
     lanes: L,
@@ -454,8 +542,13 @@ pub fn shade<L: Lanes>(
     let alpha = clamped * clamped;
     let mut color = [lanes.splat_f32(0.0); 3];
     let mut coat_color = [lanes.splat_f32(0.0); 3];
+    let zero = lanes.splat_f32(0.0);
+    let path = match &s.transmission {
+        Some(layer) => super::transmission::refraction_path(lanes, layer, &s.normal, &view),
+        None => [zero; 3],
+    };
     for light in &lighting.lights {
-        let (c, coat) = punctual(lanes, light, s, &view, &r, alpha);
+        let (c, coat) = punctual(lanes, light, s, &view, &r, alpha, &path);
         for k in 0..3 {
             color[k] = color[k] + c[k];
             coat_color[k] = coat_color[k] + coat[k];
@@ -466,6 +559,27 @@ pub fn shade<L: Lanes>(
         for k in 0..3 {
             color[k] = color[k] + ibl[k];
             coat_color[k] = coat_color[k] + coat_ibl[k];
+        }
+    }
+    if let (Some(layer), Some(through)) = (&s.transmission, &lighting.transmission) {
+        // The backdrop replaces the part `factor` of the dielectric's diffuse light (the
+        // image-based part was scaled down in `image_based`), with the same room left by the
+        // specular reflection.
+        let light = transmitted_light(
+            lanes,
+            through,
+            layer,
+            &s.position,
+            &s.normal,
+            &view,
+            s.roughness,
+        );
+        let n_dot_v = clamp01(lanes, dot3::<L>(&s.normal, &view));
+        let [a, b] = brdf_ab_lanes(lanes, n_dot_v, s.roughness);
+        let one = lanes.splat_f32(1.0);
+        for k in 0..3 {
+            let fss_ess = r.f0[k] * a + r.f90 * b;
+            color[k] = color[k] + layer.factor * r.c_diff[k] * (one - fss_ess) * light[k];
         }
     }
     for k in 0..3 {
@@ -522,9 +636,13 @@ fn image_based<L: Lanes>(
     let weight = s.occlusion * intensity;
     let (specular, a, b) = reads[0];
     let mut out = [zero; 3];
+    let kept = match &s.transmission {
+        Some(layer) => one - layer.factor,
+        None => one,
+    };
     for c in 0..3 {
         let fss_ess = r.f0[c] * a + r.f90 * b;
-        let diffuse = irradiance[c] * r.c_diff[c] * (one - fss_ess);
+        let diffuse = irradiance[c] * r.c_diff[c] * (one - fss_ess) * kept;
         out[c] = (diffuse + specular[c] * fss_ess) * weight;
     }
     let mut coat_out = [zero; 3];

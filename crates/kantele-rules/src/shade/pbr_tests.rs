@@ -39,6 +39,7 @@ fn surface(
         dielectric_f0: splat3(Vec3::splat(DIELECTRIC_F0)),
         specular_weight: Scalar.splat_f32(1.0),
         clearcoat: None,
+        transmission: None,
     }
 }
 
@@ -100,6 +101,7 @@ fn a_sphere_under_a_directional_light_matches_appendix_b() {
         eye,
         exposure: 1.0,
         tonemap: Tonemap::None,
+        transmission: None,
     };
     let mut checked = 0;
     for base in [
@@ -257,6 +259,7 @@ fn white_furnace() {
         eye: Vec3::new(0.0, 0.0, 10.0),
         exposure: 1.0,
         tonemap: Tonemap::None,
+        transmission: None,
     };
     for roughness in [0.0f32, 0.25, 0.5, 0.75, 1.0] {
         for i in 0..20 {
@@ -308,6 +311,7 @@ fn specular_and_ior_follow_the_formulas() {
         eye,
         exposure: 1.0,
         tonemap: Tonemap::None,
+        transmission: None,
     };
     let f0_of_ior = |ior: f64| ((ior - 1.0) / (ior + 1.0)).powi(2);
     let base = Vec3::new(0.8, 0.3, 0.1);
@@ -369,6 +373,7 @@ fn a_clear_coat_layers_over_the_base() {
         eye,
         exposure: 1.0,
         tonemap: Tonemap::None,
+        transmission: None,
     };
     let base = Vec3::new(0.1, 0.4, 0.9);
     let emissive = Vec3::new(0.05, 0.0, 0.2);
@@ -454,6 +459,7 @@ fn a_clear_coat_conserves_energy_in_the_furnace() {
         eye,
         exposure: 1.0,
         tonemap: Tonemap::None,
+        transmission: None,
     };
     for coat_roughness in [0.0f32, 0.5, 1.0] {
         for i in 0..20 {
