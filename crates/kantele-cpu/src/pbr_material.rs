@@ -10,8 +10,10 @@
 //! sample viewer does for meshes without tangents); then
 //! the dielectric reflectance and specular weight of `KHR_materials_ior` and
 //! `KHR_materials_specular`, the coat of `KHR_materials_clearcoat` (its factor, roughness and
-//! normal texture, bent in the same frame); then [`pbr::shade`] with the emission, exposure
-//! and the tone map.
+//! normal texture, bent in the same frame), the transmission and thickness of
+//! `KHR_materials_transmission` and `KHR_materials_volume` (where the frame has a backdrop:
+//! [`PbrLighting::transmission`]); then [`pbr::shade`] with the emission, exposure and the
+//! tone map.
 //!
 //! Each texture reads one of the mesh's two texture coordinate sets
 //! ([`TextureBinding::texcoord`](kantele_rules::scene::TextureBinding::texcoord)).
@@ -31,6 +33,7 @@ use kantele_rules::camera::normal_matrix;
 use kantele_rules::scene::{AlphaMode, Material};
 use kantele_rules::shade::pbr::{self, normalize3, ClearcoatLayer, PbrLighting, Surface};
 use kantele_rules::shade::texture::{Sampler, Texture};
+use kantele_rules::shade::transmission::{TransmissionLayer, Volume};
 use kantele_rules::vertex::PbrVertex;
 
 /// Where the PBR shader's first varyings sit; the others follow as the draw needs them
@@ -125,6 +128,10 @@ pub struct PbrTextures<'a> {
     pub clearcoat_roughness: BoundTexture<'a>,
     /// Linear tangent-space normal of the clear coat.
     pub clearcoat_normal: BoundTexture<'a>,
+    /// Linear: red = transmission (`KHR_materials_transmission`).
+    pub transmission: BoundTexture<'a>,
+    /// Linear: green = thickness (`KHR_materials_volume`).
+    pub thickness: BoundTexture<'a>,
 }
 
 impl<'a> PbrTextures<'a> {
@@ -141,14 +148,22 @@ impl<'a> PbrTextures<'a> {
             (CLEARCOAT, self.clearcoat),
             (CLEARCOAT_ROUGHNESS, self.clearcoat_roughness),
             (CLEARCOAT_NORMAL, self.clearcoat_normal),
+            (TRANSMISSION, self.transmission),
+            (THICKNESS, self.thickness),
         ]
     }
 
     /// The textures a draw of `pass` reads, with the slot of [`Texels`] each fills: all of
-    /// them for colour (the clear coat's only with a coat); the base colour (for its alpha,
-    /// where the material tests it) and the normal texture for normals; the base colour for
-    /// ids, where alpha is tested.
-    fn reads(&self, pass: Pass, alpha_tested: bool, clearcoat: bool) -> TextureReads<'a> {
+    /// them for colour (the clear coat's only with a coat, transmission and thickness only
+    /// when the draw transmits); the base colour (for its alpha, where the material tests it)
+    /// and the normal texture for normals; the base colour for ids, where alpha is tested.
+    fn reads(
+        &self,
+        pass: Pass,
+        alpha_tested: bool,
+        clearcoat: bool,
+        transmits: bool,
+    ) -> TextureReads<'a> {
         let mut reads = TextureReads {
             reads: [None; SLOTS],
             count: 0,
@@ -160,6 +175,7 @@ impl<'a> PbrTextures<'a> {
                 CLEARCOAT | CLEARCOAT_ROUGHNESS | CLEARCOAT_NORMAL => {
                     pass == Pass::Color && clearcoat
                 }
+                TRANSMISSION | THICKNESS => pass == Pass::Color && transmits,
                 _ => pass == Pass::Color,
             };
             if let (Some(bound), true) = (bound, wanted) {
@@ -182,7 +198,9 @@ const SPECULAR_COLOR: usize = 6;
 const CLEARCOAT: usize = 7;
 const CLEARCOAT_ROUGHNESS: usize = 8;
 const CLEARCOAT_NORMAL: usize = 9;
-const SLOTS: usize = 10;
+const TRANSMISSION: usize = 10;
+const THICKNESS: usize = 11;
+const SLOTS: usize = 12;
 
 /// The texels of a fragment's textures, by slot (1 where a texture is not read).
 type Texels<L> = [[<L as Lanes>::F32; 4]; SLOTS];
@@ -222,6 +240,8 @@ pub struct PbrShader<'a> {
     mirrored: bool,
     /// Where the varyings sit.
     layout: VaryingLayout,
+    /// The volume constants of a transmissive draw in a frame with a backdrop.
+    volume: Option<Volume>,
 }
 
 impl<'a> PbrShader<'a> {
@@ -237,7 +257,22 @@ impl<'a> PbrShader<'a> {
         ids: (u32, u32),
     ) -> Self {
         let alpha_tested = !matches!(material.alpha_mode, AlphaMode::Opaque);
-        let reads = textures.reads(pass, alpha_tested, material.has_clearcoat());
+        let volume = match &lighting.transmission {
+            Some(view) if material.has_transmission() && pass == Pass::Color => Some(Volume::new(
+                material.ior,
+                material.attenuation_color,
+                material.attenuation_distance,
+                &model,
+                &view.backdrop,
+            )),
+            _ => None,
+        };
+        let reads = textures.reads(
+            pass,
+            alpha_tested,
+            material.has_clearcoat(),
+            volume.is_some(),
+        );
         let mut shader = Self {
             model,
             model_view_projection: view_projection * model,
@@ -250,6 +285,7 @@ impl<'a> PbrShader<'a> {
             ids: (ids.0 as f32, ids.1 as f32),
             mirrored: Mat3::from_mat4(model).determinant() < 0.0,
             layout: VaryingLayout::new([false; 2], false, false, None),
+            volume,
         };
         shader.layout = shader.layout_for(true, false);
         shader
@@ -516,6 +552,24 @@ impl PbrShader<'_> {
             } else {
                 None
             };
+            // KHR_materials_transmission and KHR_materials_volume.
+            let transmission = if let Some(volume) = self.volume {
+                let mut factor = lanes.splat_f32(m.transmission);
+                if self.textures.transmission.is_some() {
+                    factor = factor * texels[TRANSMISSION][0];
+                }
+                let mut thickness = lanes.splat_f32(m.thickness);
+                if self.textures.thickness.is_some() {
+                    thickness = thickness * texels[THICKNESS][1];
+                }
+                Some(TransmissionLayer {
+                    factor: clamp01(lanes, factor),
+                    thickness: thickness.max(lanes.splat_f32(0.0)),
+                    volume,
+                })
+            } else {
+                None
+            };
             let surface = Surface {
                 base: [base[0], base[1], base[2]],
                 metallic: clamp01(lanes, metallic),
@@ -534,7 +588,7 @@ impl PbrShader<'_> {
                 ],
                 specular_weight: clamp01(lanes, specular_weight),
                 clearcoat,
-                transmission: None,
+                transmission,
             };
             pbr::shade(lanes, self.lighting, &surface, &emissive)
         };

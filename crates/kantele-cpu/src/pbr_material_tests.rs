@@ -11,6 +11,7 @@ use kantele_rules::setup::CullMode;
 use kantele_rules::shade::environment::EnvironmentLight;
 use kantele_rules::shade::pbr::{FrameLight, Tonemap};
 use kantele_rules::shade::texture::{ColorSpace, Filter, MinFilter, Wrap};
+use kantele_rules::shade::transmission::{Backdrop, TransmissionView};
 
 /// The shader with one fragment at a time: the trait's default `fragment_lanes`, which calls
 /// `fragment` per lane.
@@ -132,6 +133,17 @@ fn render<S: Shader<Vertex = PbrVertex>>(
 /// the samplers' rounding.
 #[test]
 fn lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time() {
+    lanes_agree(false);
+}
+
+/// [`lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time`] for a transmissive
+/// volume (textured transmission and thickness, attenuation) over a backdrop.
+#[test]
+fn transmissive_lanes_agree_across_instruction_sets() {
+    lanes_agree(true);
+}
+
+fn lanes_agree(transmissive: bool) {
     let base = linear_texture(16, |x, y| [(x * 16) as u8, (y * 16) as u8, 128, 255]);
     let bumps = linear_texture(16, |x, y| {
         let tilt = ((x as f32 * 0.7).sin() * 60.0 + 128.0) as u8;
@@ -150,6 +162,11 @@ fn lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time() {
         clearcoat: 0.9,
         clearcoat_roughness: 0.6,
         clearcoat_normal_scale: 1.2,
+        ior: 1.4,
+        transmission: if transmissive { 0.8 } else { 0.0 },
+        thickness: 0.6,
+        attenuation_color: Vec3::new(0.8, 0.5, 0.3),
+        attenuation_distance: 0.7,
         ..Material::default()
     };
     let textures = PbrTextures {
@@ -163,8 +180,19 @@ fn lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time() {
         clearcoat: bound(&mr),
         clearcoat_roughness: bound(&occlusion),
         clearcoat_normal: bound(&bumps),
+        transmission: bound(&mr),
+        thickness: bound(&base),
     };
-    let lighting = lighting(true);
+    let mut lighting = lighting(true);
+    if transmissive {
+        let picture: Vec<[f32; 4]> = (0..40 * 30)
+            .map(|i| [(i % 40) as f32 / 20.0, (i / 40) as f32 / 15.0, 0.3, 1.0])
+            .collect();
+        lighting.transmission = Some(TransmissionView {
+            backdrop: Arc::new(Backdrop::new(40, 30, &picture).expect("backdrop")),
+            view_projection: view_projection(),
+        });
+    }
     let model = Mat4::from_rotation_y(0.4) * Mat4::from_rotation_x(-0.3);
     let shader = PbrShader::new(
         model,

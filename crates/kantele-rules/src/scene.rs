@@ -293,9 +293,10 @@ impl Material {
         self.clearcoat > 0.0
     }
 
-    /// Whether light from behind shows through the material (`transmission > 0`).
+    /// Whether light from behind shows through the material (`transmission > 0`; unlit
+    /// materials transmit nothing).
     pub fn has_transmission(&self) -> bool {
-        self.transmission > 0.0
+        self.transmission > 0.0 && !self.unlit
     }
 }
 

@@ -7,12 +7,13 @@ use crate::material::{Lighting, MaterialShader, StandardVertex};
 use crate::pbr_material::{Bound, PbrShader, PbrTextures};
 use crate::pipeline::{Indices, RenderState, Renderer, RendererOptions, Shader};
 use crate::raster::Strategy;
-use crate::rop::TargetFormat;
+use crate::rop::{Framebuffer, TargetFormat};
 use kantele_rules::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele_rules::error::RenderError;
 use kantele_rules::multisample::SampleCount;
-use kantele_rules::scene::{Mesh, Scene, Shading, Topology};
-use kantele_rules::shade::pbr::PbrLighting;
+use kantele_rules::scene::{AlphaMode, Material, Mesh, Scene, Shading, Topology};
+use kantele_rules::shade::pbr::{PbrLighting, Tonemap};
+use kantele_rules::shade::transmission::{backdrop_size, Backdrop, TransmissionView};
 use kantele_rules::stats::FrameStats;
 use kantele_rules::vertex::PbrVertex;
 
@@ -82,6 +83,8 @@ pub struct CpuBackend {
     scene: Option<(Arc<Scene>, PreparedMeshes)>,
     /// The rows frames are restricted to (`None`: whole frames).
     region: Option<std::ops::Range<u32>>,
+    /// The target of the last backdrop drawn (transmissive frames), kept for the next one.
+    backdrop_target: Option<Framebuffer>,
 }
 
 impl CpuBackend {
@@ -93,6 +96,7 @@ impl CpuBackend {
             target: options.target,
             scene: None,
             region: None,
+            backdrop_target: None,
         })
     }
 
@@ -124,8 +128,8 @@ impl CpuBackend {
 }
 
 /// Clears (the scene's clear colour in the colour pass, 0 in the others) and draws every draw
-/// of `scene` in its draw order, draw `i` with `shaders[i]` under the state `state` gives it
-/// (front faces by the draw's model matrix).
+/// `i` of `scene` for which `drawn(i)` holds, in the scene's draw order, with `shaders[i]`
+/// under the state `state` gives it (front faces by the draw's model matrix).
 fn draw_scene<S: Shader>(
     renderer: &mut Renderer,
     scene: &Scene,
@@ -133,13 +137,18 @@ fn draw_scene<S: Shader>(
     view: &FrameView,
     shaders: &[S],
     state: impl Fn(&S) -> RenderState,
+    drawn: impl Fn(usize) -> bool,
 ) -> Result<FrameStats, RenderError> {
     let clear = match view.pass {
         Pass::Color => scene.clear_color,
         Pass::Normals | Pass::Ids => glam::Vec4::ZERO,
     };
     let mut frame = renderer.begin_frame(Some(clear), Some(1.0));
-    for index in scene.draw_order(&view.view) {
+    for index in scene
+        .draw_order(&view.view)
+        .into_iter()
+        .filter(|&i| drawn(i))
+    {
         let (draw, shader) = (&scene.draws[index], &shaders[index]);
         let mesh = &meshes[draw.mesh];
         let state = RenderState {
@@ -158,7 +167,8 @@ fn draw_scene<S: Shader>(
 }
 
 impl CpuBackend {
-    /// A frame of a [`Shading::Pbr`] scene (the renderer already sized for `view`).
+    /// A frame of a [`Shading::Pbr`] scene (the renderer already sized for `view`). A colour
+    /// frame with transmissive draws first draws its backdrop ([`CpuBackend::draw_backdrop`]).
     fn render_pbr(&mut self, view: &FrameView) -> Result<FrameStats, RenderError> {
         let Some((scene, meshes)) = &self.scene else {
             return Err(RenderError::InvalidScene("no scene loaded".into()));
@@ -166,53 +176,151 @@ impl CpuBackend {
         let PreparedMeshes::Pbr(meshes) = meshes else {
             return Err(layout_mismatch());
         };
-        let view_projection = view.projection * view.view;
-        let lighting = PbrLighting::for_frame(scene, view);
+        let mut lighting = PbrLighting::for_frame(scene, view);
+        let transmissive = transmissive_draws(scene);
+        if view.pass == Pass::Color && transmissive.iter().any(|&t| t) {
+            let (width, height) = backdrop_size(view.width, view.height);
+            let mut target = match self.backdrop_target.take() {
+                Some(fb) if (fb.width(), fb.height()) == (width, height) => fb,
+                _ => Framebuffer::band(
+                    width,
+                    height,
+                    0..height,
+                    SampleCount::X1,
+                    TargetFormat::LinearF32,
+                    self.renderer.threads(),
+                )?,
+            };
+            // Draw into the backdrop's target, then give the frame its own back.
+            self.renderer.swap_target(&mut target);
+            let backdrop = draw_backdrop(&mut self.renderer, scene, meshes, view, &transmissive);
+            self.renderer.swap_target(&mut target);
+            self.backdrop_target = Some(target);
+            lighting.transmission = Some(TransmissionView {
+                backdrop: Arc::new(backdrop?),
+                view_projection: view.projection * view.view,
+            });
+        }
         let unlit = scene.unlit_materials();
-        let bound = |b: Option<kantele_rules::scene::TextureBinding>| {
-            b.map(|b| Bound {
-                texture: &scene.textures[b.texture],
-                sampler: b.sampler,
-                texcoord: b.texcoord,
-            })
-        };
-        let shaders: Vec<PbrShader<'_>> = scene
-            .draws
-            .iter()
-            .enumerate()
-            .map(|(i, draw)| {
-                let material = scene.draw_material(draw.mesh, &unlit);
-                let textures = PbrTextures {
-                    base_color: bound(material.base_color_texture),
-                    emissive: bound(material.emissive_texture),
-                    metallic_roughness: bound(material.metallic_roughness_texture),
-                    normal: bound(material.normal_texture),
-                    occlusion: bound(material.occlusion_texture),
-                    specular: bound(material.specular_texture),
-                    specular_color: bound(material.specular_color_texture),
-                    clearcoat: bound(material.clearcoat_texture),
-                    clearcoat_roughness: bound(material.clearcoat_roughness_texture),
-                    clearcoat_normal: bound(material.clearcoat_normal_texture),
-                };
-                PbrShader::new(
-                    draw.model,
-                    view_projection,
-                    &lighting,
-                    material,
-                    textures,
-                    view.pass,
-                    (draw.node_index as u32 + 1, i as u32 + 1),
-                )
-                .with_mesh_attributes(
-                    scene.meshes[draw.mesh].colors.is_some(),
-                    scene.meshes[draw.mesh].tangents.is_some(),
-                )
-            })
-            .collect();
-        draw_scene(&mut self.renderer, scene, meshes, view, &shaders, |s| {
-            s.render_state()
-        })
+        let shaders = pbr_shaders(scene, &unlit, view, &lighting);
+        draw_scene(
+            &mut self.renderer,
+            scene,
+            meshes,
+            view,
+            &shaders,
+            |s| s.render_state(),
+            |_| true,
+        )
     }
+}
+
+/// Whether each draw of `scene` has a transmissive material.
+fn transmissive_draws(scene: &Scene) -> Vec<bool> {
+    let unlit = scene.unlit_materials();
+    scene
+        .draws
+        .iter()
+        .map(|draw| scene.draw_material(draw.mesh, &unlit).has_transmission())
+        .collect()
+}
+
+/// Draws the backdrop of a colour frame `view` of `scene`
+/// ([`kantele_rules::shade::transmission`]) into the renderer's target (the caller's 1-sample
+/// `f32` target of [`backdrop_size`], whole, whatever rows the frame itself is restricted to):
+/// every draw that is neither transmissive (`transmissive`) nor blended, with the frame's
+/// camera and clear colour, linear (no exposure, no tone map).
+fn draw_backdrop(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    meshes: &[PreparedMesh<PbrVertex>],
+    view: &FrameView,
+    transmissive: &[bool],
+) -> Result<Backdrop, RenderError> {
+    let (width, height) = (
+        renderer.framebuffer().width(),
+        renderer.framebuffer().height(),
+    );
+    let mut lighting = PbrLighting::for_frame(scene, view);
+    lighting.exposure = 1.0;
+    lighting.tonemap = Tonemap::None;
+    let unlit = scene.unlit_materials();
+    let shaders = pbr_shaders(scene, &unlit, view, &lighting);
+    let blended = |i: usize| {
+        let draw = &scene.draws[i];
+        scene
+            .meshes
+            .get(draw.mesh)
+            .and_then(|m| scene.materials.get(m.material))
+            .is_some_and(|m| m.alpha_mode == AlphaMode::Blend)
+    };
+    draw_scene(
+        renderer,
+        scene,
+        meshes,
+        view,
+        &shaders,
+        |s| s.render_state(),
+        |i| !transmissive[i] && !blended(i),
+    )?;
+    let color = renderer.framebuffer().try_read_color()?;
+    Backdrop::new(width, height, &color).ok_or_else(|| {
+        RenderError::InvalidScene(format!(
+            "the backdrop of {width} x {height} pixels could not be built"
+        ))
+    })
+}
+
+/// The shaders of every draw of a PBR frame `view` of `scene` lit by `lighting`.
+fn pbr_shaders<'a>(
+    scene: &'a Scene,
+    unlit: &'a [Material],
+    view: &FrameView,
+    lighting: &'a PbrLighting,
+) -> Vec<PbrShader<'a>> {
+    let view_projection = view.projection * view.view;
+    let bound = |b: Option<kantele_rules::scene::TextureBinding>| {
+        b.map(|b| Bound {
+            texture: &scene.textures[b.texture],
+            sampler: b.sampler,
+            texcoord: b.texcoord,
+        })
+    };
+    scene
+        .draws
+        .iter()
+        .enumerate()
+        .map(|(i, draw)| {
+            let material = scene.draw_material(draw.mesh, unlit);
+            let textures = PbrTextures {
+                base_color: bound(material.base_color_texture),
+                emissive: bound(material.emissive_texture),
+                metallic_roughness: bound(material.metallic_roughness_texture),
+                normal: bound(material.normal_texture),
+                occlusion: bound(material.occlusion_texture),
+                specular: bound(material.specular_texture),
+                specular_color: bound(material.specular_color_texture),
+                clearcoat: bound(material.clearcoat_texture),
+                clearcoat_roughness: bound(material.clearcoat_roughness_texture),
+                clearcoat_normal: bound(material.clearcoat_normal_texture),
+                transmission: bound(material.transmission_texture),
+                thickness: bound(material.thickness_texture),
+            };
+            PbrShader::new(
+                draw.model,
+                view_projection,
+                lighting,
+                material,
+                textures,
+                view.pass,
+                (draw.node_index as u32 + 1, i as u32 + 1),
+            )
+            .with_mesh_attributes(
+                scene.meshes[draw.mesh].colors.is_some(),
+                scene.meshes[draw.mesh].tangents.is_some(),
+            )
+        })
+        .collect()
 }
 
 impl Backend for CpuBackend {
@@ -327,9 +435,15 @@ impl Backend for CpuBackend {
                 .with_vertex_colors(scene.meshes[draw.mesh].colors.is_some())
             })
             .collect();
-        draw_scene(&mut self.renderer, scene, meshes, view, &shaders, |s| {
-            s.render_state()
-        })
+        draw_scene(
+            &mut self.renderer,
+            scene,
+            meshes,
+            view,
+            &shaders,
+            |s| s.render_state(),
+            |_| true,
+        )
     }
 
     fn set_samples(&mut self, samples: SampleCount) -> Result<(), RenderError> {
@@ -452,5 +566,100 @@ mod tests {
                 assert!((x - y).abs() <= 1e-6, "{a:?} vs {b:?}");
             }
         }
+    }
+
+    /// A red quad behind a clear, thin-walled pane: through the pane the red shows as without
+    /// the pane, less the pane's reflection, where an opaque white pane hides it; a frame drawn in two bands is
+    /// the whole frame's, although each band's transmission reads the whole backdrop.
+    #[test]
+    fn a_clear_pane_shows_what_is_behind_it() {
+        let quad = |z: f32, material: usize| Mesh {
+            positions: vec![
+                Vec3::new(-0.5, -0.5, z),
+                Vec3::new(0.5, -0.5, z),
+                Vec3::new(0.5, 0.5, z),
+                Vec3::new(-0.5, 0.5, z),
+            ],
+            normals: Some(vec![Vec3::Z; 4]),
+            indices: vec![0, 1, 2, 0, 2, 3],
+            material,
+            ..Mesh::default()
+        };
+        // The pane's transmission, or no pane.
+        let frame = |pane: Option<f32>, band: bool| {
+            let transmission = pane.unwrap_or(0.0);
+            let draws = if pane.is_some() { 2 } else { 1 };
+            let scene = Scene {
+                meshes: vec![quad(-0.3, 0), quad(0.0, 1)],
+                materials: vec![
+                    Material {
+                        base_color_factor: Vec4::new(1.0, 0.0, 0.0, 1.0),
+                        metallic: 0.0,
+                        ..Material::default()
+                    },
+                    Material {
+                        metallic: 0.0,
+                        roughness: 0.0,
+                        transmission,
+                        ..Material::default()
+                    },
+                ],
+                draws: (0..draws)
+                    .map(|i| Draw {
+                        mesh: i,
+                        model: Mat4::from_scale(Vec3::new(2.0, 2.0, 1.0)),
+                        node_name: String::new(),
+                        node_index: i,
+                    })
+                    .collect(),
+                camera: kantele_rules::scene::Camera::framing(Vec3::ZERO, 1.0, Vec3::Z, 1.0),
+                resolution: (48, 48),
+                shading: Shading::Pbr,
+                clear_color: Vec4::ZERO,
+                ..Scene::default()
+            };
+            let mut cpu = CpuBackend::new(CpuOptions::default()).expect("cpu");
+            cpu.load(Arc::new(scene.clone())).expect("load");
+            let view = FrameView::of_scene(&scene);
+            if !band {
+                cpu.render(&view).expect("render");
+                return cpu.read_frame().expect("read").color;
+            }
+            let mut color = Vec::new();
+            for rows in [0..20, 20..48] {
+                cpu.set_render_region(Some(rows)).expect("region");
+                cpu.render(&view).expect("render");
+                color.extend(cpu.read_frame().expect("read").color);
+            }
+            color
+        };
+        // Off the centre, away from the headlight's highlight on the smooth pane.
+        let centre = 30 * 48 + 14;
+        let clear = frame(Some(1.0), false);
+        let opaque = frame(Some(0.0), false);
+        let bare = frame(None, false)[centre];
+        assert!(
+            bare[0] > 0.2 && bare[1] < 1e-3,
+            "the red quad alone: {bare:?}"
+        );
+        let c = clear[centre];
+        let kept = c[0] / bare[0];
+        assert!(
+            (0.85..1.0).contains(&kept) && c[1] < 1e-3,
+            "through the pane: {c:?}, {kept} of the red"
+        );
+        let o = opaque[centre];
+        assert!(
+            o[1] > 0.2 && (o[0] - o[1]).abs() < 0.01,
+            "opaque pane: {o:?}"
+        );
+        let banded = frame(Some(1.0), true);
+        assert!(
+            banded
+                .iter()
+                .zip(&clear)
+                .all(|(a, b)| a.map(f32::to_bits) == b.map(f32::to_bits)),
+            "two bands differ from the whole frame"
+        );
     }
 }

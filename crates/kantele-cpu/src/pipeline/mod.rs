@@ -265,6 +265,13 @@ impl Renderer {
         &self.framebuffer
     }
 
+    /// Exchanges the colour and depth target with `other`: a second target kept between
+    /// frames (the CPU backend's backdrop of transmissive frames) is drawn into without
+    /// rebuilding either.
+    pub(crate) fn swap_target(&mut self, other: &mut Framebuffer) {
+        std::mem::swap(&mut self.framebuffer, other);
+    }
+
     /// Starts a frame: optionally clears colour and depth, then collects draws until
     /// [`Frame::end`].
     pub fn begin_frame<'a>(

@@ -514,9 +514,9 @@ fn punctual_transmission<L: Lanes>(
 
 /// The linear colour of a lit surface point emitting `emissive`, before exposure and tone
 /// mapping: every punctual light by Appendix B (`punctual`), plus image-based light (diffuse
-/// irradiance × `c_diff × (1 − FssEss)` and the pre-filtered specular radiance × `FssEss = F0 A
-/// + F90 B`, both × occlusion), where `A`, `B` are the split-sum terms of the environment's
-/// BRDF table; plus the emission. With a clear coat of weight `k` (`KHR_materials_clearcoat`)
+/// irradiance × `c_diff × (1 − FssEss)` and the pre-filtered specular radiance ×
+/// `FssEss = F0 A + F90 B`, both × occlusion), where `A`, `B` are the split-sum terms of the
+/// environment's BRDF table; plus the emission. With a clear coat of weight `k` (`KHR_materials_clearcoat`)
 /// that sum is scaled by `1 − k F_coat(N_coat·V)` and the coat's own lobe, × `k`, is added.
 /// With transmission of weight `t` (a [`TransmissionLayer`] and a frame's
 /// [`TransmissionView`]), `t` of the diffuse light (image-based and punctual) is replaced by

@@ -66,39 +66,41 @@ impl Backdrop {
             return None;
         }
         let clean = |v: f32| if v > 0.0 { v.min(MAX_RADIANCE) } else { 0.0 };
-        let mut level: Vec<[f32; 3]> = rgba
-            .iter()
-            .map(|p| [clean(p[0]), clean(p[1]), clean(p[2])])
-            .collect();
+        // Every level's texels, four words each; the chain adds at most a third.
+        let mut texel_bits = Vec::with_capacity(rgba.len() / 3 * 16 + 32);
+        for p in rgba {
+            texel_bits.extend_from_slice(&[
+                clean(p[0]).to_bits(),
+                clean(p[1]).to_bits(),
+                clean(p[2]).to_bits(),
+                0,
+            ]);
+        }
         let mut sizes = vec![(width, height)];
-        let mut texels = level.clone();
-        let (mut w, mut h) = (width, height);
+        let (mut w, mut h, mut first) = (width, height, 0usize);
         while w > 1 || h > 1 {
             let (next_w, next_h) = ((w / 2).max(1), (h / 2).max(1));
-            let mut next = Vec::with_capacity(next_w as usize * next_h as usize);
+            let next_first = texel_bits.len() / 4;
+            let texel = |x: u32, y: u32| first + (y * w + x) as usize;
             for y in 0..next_h {
+                // The rows and columns of each 2 × 2 block, the last repeated at an odd edge
+                // (a side of 1 halves to 1).
+                let (y0, y1) = ((2 * y).min(h - 1), (2 * y + 1).min(h - 1));
                 for x in 0..next_w {
-                    let at = |x: u32, y: u32| level[(y.min(h - 1) * w + x.min(w - 1)) as usize];
-                    let quad = [
-                        at(2 * x, 2 * y),
-                        at(2 * x + 1, 2 * y),
-                        at(2 * x, 2 * y + 1),
-                        at(2 * x + 1, 2 * y + 1),
-                    ];
-                    let mut mean = [0.0f32; 3];
-                    for (c, m) in mean.iter_mut().enumerate() {
-                        *m = ((quad[0][c] + quad[1][c]) + (quad[2][c] + quad[3][c])) * 0.25;
+                    let (x0, x1) = ((2 * x).min(w - 1), (2 * x + 1).min(w - 1));
+                    let quad = [texel(x0, y0), texel(x1, y0), texel(x0, y1), texel(x1, y1)];
+                    let channel = |t: usize, c: usize| f32::from_bits(texel_bits[t * 4 + c]);
+                    let mut mean = [0u32; 4];
+                    for (c, m) in mean[..3].iter_mut().enumerate() {
+                        let top = channel(quad[0], c) + channel(quad[1], c);
+                        let bottom = channel(quad[2], c) + channel(quad[3], c);
+                        *m = ((top + bottom) * 0.25).to_bits();
                     }
-                    next.push(mean);
+                    texel_bits.extend_from_slice(&mean);
                 }
             }
-            texels.extend_from_slice(&next);
             sizes.push((next_w, next_h));
-            (w, h, level) = (next_w, next_h, next);
-        }
-        let mut texel_bits = Vec::with_capacity((texels.len() + 1) * 4);
-        for t in &texels {
-            texel_bits.extend_from_slice(&[t[0].to_bits(), t[1].to_bits(), t[2].to_bits(), 0]);
+            (w, h, first) = (next_w, next_h, next_first);
         }
         texel_bits.extend_from_slice(&[0; 4]);
         Some(Self {
@@ -366,7 +368,7 @@ fn clip_row<L: Lanes>(lanes: L, m: &Mat4, r: usize, p: &[L::F32; 3]) -> L::F32 {
 pub fn exp2_nonpositive<L: Lanes>(lanes: L, x: L::F32) -> L::F32 {
     // Taylor coefficients of 2^f = e^(f ln 2): (ln 2)^k / k!.
     const C: [f32; 7] = [
-        0.693_147_2,
+        std::f32::consts::LN_2,
         0.240_226_5,
         0.055_504_11,
         0.009_618_129,

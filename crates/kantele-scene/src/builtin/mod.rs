@@ -38,6 +38,10 @@ pub const SCENES: &[(&str, &str)] = &[
         "pbr-lights",
         "PBR: a normal-mapped floor, a gold and a plastic sphere under a point and a spot light with ranges",
     ),
+    (
+        "pbr-glass",
+        "PBR: clear and frosted glass panes, a clear and a tinted glass volume over a checker (transmission)",
+    ),
 ];
 
 /// Background of the built-in scenes: a dark grey-blue (linear).
@@ -52,6 +56,7 @@ pub fn build(name: &str) -> Option<LoadedScene> {
         "pixel-edges" => pixel_edges::scene(),
         "pbr-spheres" => pbr::spheres(),
         "pbr-lights" => pbr::lights(),
+        "pbr-glass" => pbr::glass(),
         _ => return None,
     };
     Some(finish(name, scene, info))

@@ -1,6 +1,6 @@
 //! Built-in PBR scenes, the reference scenes of the metallic-roughness model: a grid of spheres
-//! over metallic × roughness in the studio environment, and a normal-mapped floor under point
-//! and spot lights with ranges.
+//! over metallic × roughness in the studio environment, a normal-mapped floor under point
+//! and spot lights with ranges, and transmissive panes and volumes over a checker.
 
 use std::f32::consts::PI;
 use std::sync::Arc;
@@ -254,6 +254,155 @@ pub fn lights() -> (Scene, SceneInfo) {
         ],
         environment: None,
         clear_color: Vec4::new(0.02, 0.02, 0.025, 1.0),
+        resolution: (960, 640),
+        ..Scene::default()
+    };
+    let info = SceneInfo {
+        camera_from_file: true,
+        lights: scene.lights.iter().map(|_| "light".to_string()).collect(),
+        ..SceneInfo::default()
+    };
+    (scene, info)
+}
+
+/// A `size²` sRGB checker of `cells` squares per side, cream and slate.
+fn checker(size: u32, cells: u32) -> Texture {
+    let rgba: Vec<u8> = (0..size * size)
+        .flat_map(|i| {
+            let (x, y) = (i % size, i / size);
+            let cell = (size / cells).max(1);
+            if (x / cell + y / cell) % 2 == 0 {
+                [232, 226, 210, 255]
+            } else {
+                [46, 58, 74, 255]
+            }
+        })
+        .collect();
+    Texture::from_rgba8(size, size, &rgba, ColorSpace::Srgb)
+        .expect("a generated checker is a valid texture")
+}
+
+/// `pbr-glass`: over a checkered floor and wall, in the studio with a key light: a clear
+/// blue-tinted thin-walled pane, a frosted pane (roughness 0.45), a clear glass sphere refracting the
+/// checker (a volume 2 thick, IOR 1.5), a green-tinted glass sphere (Beer's law over 0.8) and
+/// an opaque red sphere beside them (`KHR_materials_transmission`, `KHR_materials_volume`).
+pub fn glass() -> (Scene, SceneInfo) {
+    let glass = |name: &str, roughness: f32| Material {
+        name: name.into(),
+        base_color_factor: Vec4::ONE,
+        metallic: 0.0,
+        roughness,
+        transmission: 1.0,
+        double_sided: true,
+        ..Material::default()
+    };
+    let materials = vec![
+        Material {
+            name: "checker".into(),
+            base_color_factor: Vec4::ONE,
+            base_color_texture: Some(TextureBinding {
+                texture: 0,
+                sampler: trilinear_repeat(),
+                texcoord: 0,
+            }),
+            metallic: 0.0,
+            roughness: 0.7,
+            ..Material::default()
+        },
+        Material {
+            base_color_factor: Vec4::new(0.75, 0.9, 1.0, 1.0),
+            ..glass("blue pane", 0.0)
+        },
+        glass("frosted pane", 0.45),
+        Material {
+            thickness: 2.0,
+            ..glass("clear volume", 0.0)
+        },
+        Material {
+            thickness: 2.0,
+            attenuation_color: Vec3::new(0.3, 0.85, 0.45),
+            attenuation_distance: 0.8,
+            ..glass("green volume", 0.05)
+        },
+        Material {
+            name: "red".into(),
+            base_color_factor: Vec4::new(0.7, 0.06, 0.04, 1.0),
+            metallic: 0.0,
+            roughness: 0.3,
+            ..Material::default()
+        },
+    ];
+    let meshes = vec![
+        floor(0, 6.0),
+        floor(1, 1.0),
+        floor(2, 1.0),
+        sphere(32, 48, 3),
+        sphere(32, 48, 4),
+        sphere(32, 48, 5),
+    ];
+    // Panes stand upright facing the camera (+Z): the floor square turned about X.
+    let upright = Mat4::from_rotation_x(PI / 2.0);
+    let draws = vec![
+        draw(0, Mat4::from_scale(Vec3::splat(6.0)), "floor".into(), 0),
+        draw(
+            0,
+            Mat4::from_translation(Vec3::new(0.0, 3.0, -3.0))
+                * upright
+                * Mat4::from_scale(Vec3::new(6.0, 1.0, 3.0)),
+            "wall".into(),
+            1,
+        ),
+        draw(
+            1,
+            Mat4::from_translation(Vec3::new(-2.6, 1.1, 0.8))
+                * upright
+                * Mat4::from_scale(Vec3::new(0.9, 1.0, 1.1)),
+            "blue pane".into(),
+            2,
+        ),
+        draw(
+            2,
+            Mat4::from_translation(Vec3::new(2.6, 1.1, 0.8))
+                * upright
+                * Mat4::from_scale(Vec3::new(0.9, 1.0, 1.1)),
+            "frosted pane".into(),
+            3,
+        ),
+        draw(
+            3,
+            Mat4::from_translation(Vec3::new(-0.75, 0.9, 1.2)) * Mat4::from_scale(Vec3::splat(0.9)),
+            "clear sphere".into(),
+            4,
+        ),
+        draw(
+            4,
+            Mat4::from_translation(Vec3::new(0.95, 0.9, 1.0)) * Mat4::from_scale(Vec3::splat(0.9)),
+            "green sphere".into(),
+            5,
+        ),
+        draw(
+            5,
+            Mat4::from_translation(Vec3::new(0.1, 0.6, -1.4)) * Mat4::from_scale(Vec3::splat(0.6)),
+            "red sphere".into(),
+            6,
+        ),
+    ];
+    let scene = Scene {
+        meshes,
+        materials,
+        textures: vec![Arc::new(checker(256, 8))],
+        draws,
+        camera: perspective(Vec3::new(0.0, 2.6, 7.5), Vec3::new(0.0, 1.0, 0.0), 40.0),
+        shading: Shading::Pbr,
+        lights: vec![PunctualLight {
+            kind: LightKind::Directional,
+            color: Vec3::splat(2.0),
+            position: Vec3::ZERO,
+            direction: Vec3::new(0.4, -0.8, -0.5).normalize(),
+            range: None,
+        }],
+        environment: Some(EnvironmentLight::studio()),
+        clear_color: crate::shading::PBR_BACKGROUND,
         resolution: (960, 640),
         ..Scene::default()
     };

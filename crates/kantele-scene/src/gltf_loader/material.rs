@@ -116,6 +116,8 @@ pub(super) enum TextureSlot {
     Clearcoat,
     ClearcoatRoughness,
     ClearcoatNormal,
+    Transmission,
+    Thickness,
 }
 
 impl TextureSlot {
@@ -131,6 +133,8 @@ impl TextureSlot {
             TextureSlot::Clearcoat => "clear coat",
             TextureSlot::ClearcoatRoughness => "clear-coat roughness",
             TextureSlot::ClearcoatNormal => "clear-coat normal",
+            TextureSlot::Transmission => "transmission",
+            TextureSlot::Thickness => "thickness",
         }
     }
 }
@@ -272,6 +276,11 @@ impl<'a> Loader<'a> {
             clearcoat: extensions.clearcoat,
             clearcoat_roughness: extensions.clearcoat_roughness,
             clearcoat_normal_scale: extensions.clearcoat_normal_scale,
+            ior: extensions.ior,
+            transmission: extensions.transmission,
+            thickness: extensions.thickness,
+            attenuation_color: extensions.attenuation_color,
+            attenuation_distance: extensions.attenuation_distance,
             ..Material::default()
         };
         if let Some(converted) = spec_gloss {
@@ -328,6 +337,8 @@ impl<'a> Loader<'a> {
                 TextureSlot::Clearcoat => out.clearcoat_texture = binding,
                 TextureSlot::ClearcoatRoughness => out.clearcoat_roughness_texture = binding,
                 TextureSlot::ClearcoatNormal => out.clearcoat_normal_texture = binding,
+                TextureSlot::Transmission => out.transmission_texture = binding,
+                TextureSlot::Thickness => out.thickness_texture = binding,
             }
         }
         self.material_uv.push(maps);

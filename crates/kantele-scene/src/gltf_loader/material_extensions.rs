@@ -1,6 +1,7 @@
 //! The material extensions read from a material's JSON: `KHR_materials_ior`,
-//! `KHR_materials_specular` and `KHR_materials_clearcoat` — their factors, and their textures
-//! with the colour space and texture coordinates each reads.
+//! `KHR_materials_specular`, `KHR_materials_clearcoat`, `KHR_materials_transmission` and
+//! `KHR_materials_volume` — their factors, and their textures with the colour space and
+//! texture coordinates each reads.
 
 use glam::Vec3;
 use kantele_rules::shade::texture::ColorSpace;
@@ -21,6 +22,16 @@ pub(super) struct MaterialExtensions<'a> {
     pub(super) clearcoat_roughness: f32,
     /// `clearcoatNormalTexture.scale`.
     pub(super) clearcoat_normal_scale: f32,
+    /// `ior` (1.5 without the extension).
+    pub(super) ior: f32,
+    /// `transmissionFactor`.
+    pub(super) transmission: f32,
+    /// `thicknessFactor` (0 without `KHR_materials_volume`).
+    pub(super) thickness: f32,
+    /// `attenuationColor`.
+    pub(super) attenuation_color: Vec3,
+    /// `attenuationDistance` (infinite without it).
+    pub(super) attenuation_distance: f32,
     /// The extensions' textures.
     pub(super) textures: Vec<(TextureSlot, gltf::texture::Texture<'a>, ColorSpace, UvMap)>,
 }
@@ -67,6 +78,21 @@ impl<'a> Loader<'a> {
             })
             .unwrap_or(Vec3::ONE);
         let clearcoat = material.extension_value("KHR_materials_clearcoat");
+        let transmission = material.extension_value("KHR_materials_transmission");
+        // KHR_materials_volume only applies under transmission (or diffuse transmission).
+        let volume = material
+            .extension_value("KHR_materials_volume")
+            .filter(|_| transmission.is_some());
+        let attenuation_color = volume
+            .and_then(|v| v.get("attenuationColor"))
+            .and_then(Value::as_array)
+            .and_then(|a| {
+                let c = |i: usize| a.get(i)?.as_f64().filter(|v| v.is_finite());
+                Some(Vec3::new(c(0)? as f32, c(1)? as f32, c(2)? as f32))
+            })
+            .unwrap_or(Vec3::ONE)
+            .clamp(Vec3::ZERO, Vec3::ONE);
+        let attenuation_distance = number(volume, "attenuationDistance", f64::INFINITY);
         let mut out = MaterialExtensions {
             dielectric_f0: Vec3::splat(f0_of_ior(ior)) * color,
             specular_weight: number(specular, "specularFactor", 1.0).clamp(0.0, 1.0) as f32,
@@ -78,6 +104,15 @@ impl<'a> Loader<'a> {
                 "scale",
                 1.0,
             ) as f32,
+            ior: ior as f32,
+            transmission: number(transmission, "transmissionFactor", 0.0).clamp(0.0, 1.0) as f32,
+            thickness: number(volume, "thicknessFactor", 0.0).max(0.0) as f32,
+            attenuation_color,
+            attenuation_distance: if attenuation_distance > 0.0 {
+                attenuation_distance as f32
+            } else {
+                f32::INFINITY
+            },
             textures: Vec::new(),
         };
         let references = [
@@ -109,6 +144,18 @@ impl<'a> Loader<'a> {
                 clearcoat,
                 "clearcoatNormalTexture",
                 TextureSlot::ClearcoatNormal,
+                ColorSpace::Linear,
+            ),
+            (
+                transmission,
+                "transmissionTexture",
+                TextureSlot::Transmission,
+                ColorSpace::Linear,
+            ),
+            (
+                volume,
+                "thicknessTexture",
+                TextureSlot::Thickness,
                 ColorSpace::Linear,
             ),
         ];

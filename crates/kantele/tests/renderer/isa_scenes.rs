@@ -63,7 +63,14 @@ fn assert_levels_agree(name: &str, scene: Scene, samples: SampleCount, pass: Pas
 
 #[test]
 fn built_in_scenes_are_identical_at_every_level() {
-    for name in ["cube", "teapot", "ground", "pbr-spheres", "pbr-lights"] {
+    for name in [
+        "cube",
+        "teapot",
+        "ground",
+        "pbr-spheres",
+        "pbr-lights",
+        "pbr-glass",
+    ] {
         let scene = builtin_scene(name).expect("built-in scene").scene;
         assert_levels_agree(name, scene, SampleCount::X1, Pass::Color);
     }
