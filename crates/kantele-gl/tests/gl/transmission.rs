@@ -1,9 +1,9 @@
 //! Transmission (`KHR_materials_transmission`, `KHR_materials_volume`) drawn by the OpenGL
 //! backend against the rules of `kantele_rules::shade::transmission` and `shade::pbr`
 //! evaluated directly (scalar lanes) at each pixel centre's point on a transmissive pane in
-//! front of a checkered, unlit wall: a thin pane, rough and thick panes of two indices of
+//! front of a checkered, unlit wall: a thin pane, rough and thick panes of three indices of
 //! refraction with textures and a light behind them, a volume that attenuates, a multisampled
-//! frame and a frame wider than the largest backdrop.
+//! frame, a frame wider than the largest backdrop, the 8-bit target and the normal pass.
 //!
 //! The rules read the backdrop that the frame's definition names — the scene without its
 //! transmissive and blended draws, no tone map, exposure 1, at `backdrop_size`, one sample —
@@ -582,4 +582,58 @@ fn a_wide_frame_reads_a_smaller_backdrop() {
         exposure: 0.0,
     };
     check(&mut gl, &setup, size, SampleCount::X1, "wide frame");
+}
+
+/// The 8-bit target draws the same frame (its backdrop stays float), to within its
+/// quantisation; the normal pass draws no backdrop and writes the pane's normal.
+#[test]
+fn the_fast_target_and_the_normal_pass_draw_transmissive_scenes() {
+    let Some(mut gl) = gl_or_skip() else {
+        return;
+    };
+    let setup = Setup {
+        pane: Material {
+            thickness: 0.4,
+            ..glass(0.3)
+        },
+        textures: Vec::new(),
+        scale: Vec3::ONE,
+        lights: Vec::new(),
+        environment: true,
+        tonemap: Tonemap::PbrNeutral,
+        exposure: 0.0,
+    };
+    let reference = check(&mut gl, &setup, (W, H), SampleCount::X1, "float target");
+    let scene = Arc::new(scene(&setup, (W, H)));
+    let view = frame(&scene, (W, H));
+    gl.set_fast_target(true);
+    let fast = render(&mut gl, &scene, &view);
+    gl.set_fast_target(false);
+    for (i, (a, b)) in fast.color.iter().zip(&reference.image.color).enumerate() {
+        for c in 0..3 {
+            let want = b[c].clamp(0.0, 1.0);
+            assert!(
+                (a[c] - want).abs() <= 0.5 / 255.0 + 1e-3,
+                "pixel {i}: 8-bit {a:?} vs float {b:?}"
+            );
+        }
+    }
+    let normals = render(
+        &mut gl,
+        &scene,
+        &FrameView {
+            pass: kantele_rules::backend::Pass::Normals,
+            ..view
+        },
+    );
+    let model = pane_model(Vec3::ONE);
+    let n = (normal_matrix(&model) * Vec3::Z).normalize();
+    let centre = normals.color[(H / 2 * W + W / 2) as usize];
+    assert!(
+        (Vec3::new(centre[0], centre[1], centre[2]) - n)
+            .abs()
+            .max_element()
+            < 1e-5,
+        "normal pass at the centre: {centre:?}, pane normal {n}"
+    );
 }
