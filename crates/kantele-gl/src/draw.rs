@@ -1,23 +1,56 @@
 //! One frame's GL commands: the fixed state, the program of the scene's shading (Lambert or
 //! PBR) and its frame uniforms, then per draw its culling, alpha mode, blending, uniforms,
 //! textures and primitive mode, in the scene's draw order.
+//!
+//! A PBR colour frame with a transmissive draw is drawn twice: first its backdrop
+//! (`kantele_rules::shade::transmission`: the draws that are neither transmissive nor blended,
+//! linear — no tone map, exposure 1 — at `backdrop_size`, one sample, into a `GL_RGBA32F`
+//! framebuffer), read back into the rules' [`Backdrop`] and uploaded with its mip chain, then
+//! the frame with the backdrop bound.
+
+use std::sync::Arc;
 
 use glam::{Mat3, Mat4, Vec4};
 use glow::HasContext;
 use kantele_rules::backend::{FrameView, Pass};
 use kantele_rules::camera::normal_matrix;
-use kantele_rules::scene::{AlphaMode, Material, Mesh, Scene, Shading, TextureBinding, Topology};
-use kantele_rules::shade::pbr::PbrLighting;
+use kantele_rules::scene::{
+    AlphaMode, Draw, Material, Mesh, Scene, Shading, TextureBinding, Topology,
+};
+use kantele_rules::shade::pbr::{PbrLighting, Tonemap};
+use kantele_rules::shade::transmission::{backdrop_size, Backdrop, TransmissionView, Volume};
 use kantele_rules::stats::FrameStats;
 use kantele_rules::RenderError;
 
-use crate::pbr;
+use crate::resources::{upload_backdrop, GpuBackdrop};
+use crate::{backend_error, pbr};
 use crate::{shaders, GlBackend};
+
+/// What one pass of [`GlBackend::draw_pass`] draws, and where.
+struct PassSetup<'a> {
+    framebuffer: glow::Framebuffer,
+    /// The viewport's size.
+    size: (u32, u32),
+    /// Clear and draw depth alone (colour writes off).
+    depth_only: bool,
+    /// The PBR program's lighting (`None` for Lambert scenes).
+    lighting: Option<&'a PbrLighting>,
+    /// The frame's backdrop, when it has transmissive draws.
+    backdrop: Option<&'a GpuBackdrop>,
+    /// Draw only what a backdrop shows: the draws neither transmissive nor blended.
+    backdrop_pass: bool,
+}
+
+/// Whether `draw` is transmissive (its material's `transmission` is above 0).
+fn transmissive(scene: &Scene, draw: &Draw) -> bool {
+    scene.materials[scene.meshes[draw.mesh].material].has_transmission()
+}
 
 impl GlBackend {
     /// Clear + every draw + glFinish into `framebuffer` (the target's or its multisampled
     /// one), with the context current. `depth_only` clears and draws depth alone (colour
-    /// writes off): the per-pixel depth of a multisampled frame.
+    /// writes off): the per-pixel depth of a multisampled frame. A PBR colour frame with a
+    /// transmissive draw first draws its backdrop (see the module docs).
     pub(crate) fn draw_frame(
         &self,
         scene: &Scene,
@@ -26,7 +59,93 @@ impl GlBackend {
         depth_only: bool,
         stats: &mut FrameStats,
     ) -> Result<(), RenderError> {
+        let target = self.target.as_ref().expect("target was created");
+        let size = (target.width, target.height);
+        let pbr = scene.shading == Shading::Pbr;
+        let mut lighting = pbr.then(|| PbrLighting::for_frame(scene, view));
+        let with_backdrop = pbr
+            && view.pass == Pass::Color
+            && !depth_only
+            && scene.draws.iter().any(|d| transmissive(scene, d));
+        let backdrop = match (&mut lighting, with_backdrop) {
+            (Some(lighting), true) => {
+                let backdrop = self.draw_backdrop(scene, view, lighting)?;
+                lighting.transmission = Some(TransmissionView {
+                    backdrop: backdrop.backdrop.clone(),
+                    view_projection: view.projection * view.view,
+                });
+                Some(backdrop)
+            }
+            _ => None,
+        };
+        let setup = PassSetup {
+            framebuffer,
+            size,
+            depth_only,
+            lighting: lighting.as_ref(),
+            backdrop: backdrop.as_ref(),
+            backdrop_pass: false,
+        };
+        let result = self.draw_pass(scene, view, &setup, stats);
+        if let Some(backdrop) = backdrop {
+            // SAFETY: `gl` is current on this thread; the texture is ours and no longer used.
+            unsafe { self.gl.delete_texture(backdrop.texture) };
+        }
+        result
+    }
+
+    /// The backdrop of a frame of `scene` seen as `view` lit by `lighting`: its opaque draws
+    /// drawn linear into a one-sample `GL_RGBA32F` framebuffer of [`backdrop_size`], read back
+    /// (row 0 at the top, as the y-flipped projection draws it), turned into the rules'
+    /// [`Backdrop`] and uploaded.
+    fn draw_backdrop(
+        &self,
+        scene: &Scene,
+        view: &FrameView,
+        lighting: &PbrLighting,
+    ) -> Result<GpuBackdrop, RenderError> {
+        let (width, height) = backdrop_size(view.width, view.height);
+        let linear = PbrLighting {
+            tonemap: Tonemap::None,
+            exposure: 1.0,
+            transmission: None,
+            ..lighting.clone()
+        };
+        let framebuffer = self.create_backdrop_target(width, height)?;
+        let setup = PassSetup {
+            framebuffer: framebuffer.framebuffer,
+            size: (width, height),
+            depth_only: false,
+            lighting: Some(&linear),
+            backdrop: None,
+            backdrop_pass: true,
+        };
+        let drawn = self.draw_pass(scene, view, &setup, &mut FrameStats::default());
+        let pixels = drawn.and_then(|()| self.read_color(framebuffer.framebuffer, width, height));
+        self.delete_backdrop_target(framebuffer);
+        let backdrop = Backdrop::new(width, height, &pixels?)
+            .ok_or_else(|| backend_error(format!("backdrop {width}x{height}: no chain")))?;
+        // SAFETY: `gl` is current on this thread.
+        let uploaded = unsafe { upload_backdrop(&self.gl, Arc::new(backdrop)) }
+            .map_err(|e| backend_error(format!("uploading the backdrop: {e}")))?;
+        if let Err(e) = self.check("uploading the backdrop") {
+            // SAFETY: `gl` is current on this thread; the texture is ours and unused.
+            unsafe { self.gl.delete_texture(uploaded.texture) };
+            return Err(e);
+        }
+        Ok(uploaded)
+    }
+
+    /// Clear + the draws of `setup` + glFinish, with the context current.
+    fn draw_pass(
+        &self,
+        scene: &Scene,
+        view: &FrameView,
+        setup: &PassSetup,
+        stats: &mut FrameStats,
+    ) -> Result<(), RenderError> {
         let gl = &self.gl;
+        let (framebuffer, depth_only) = (setup.framebuffer, setup.depth_only);
         // Lambert scenes: the Lambert program, its uniforms and GL calls exactly as ever.
         let pbr = scene.shading == Shading::Pbr;
         let (program, u) = if pbr {
@@ -52,10 +171,9 @@ impl GlBackend {
         // and samplers are ours and alive; every draw's mesh, material and texture index was
         // checked by `Scene::validate` in `load`, and index buffers only hold in-range indices.
         unsafe {
-            let target = self.target.as_ref().expect("target was created");
             gl.bind_framebuffer(glow::FRAMEBUFFER, Some(framebuffer));
             gl.draw_buffers(&[glow::COLOR_ATTACHMENT0]);
-            gl.viewport(0, 0, target.width as i32, target.height as i32);
+            gl.viewport(0, 0, setup.size.0 as i32, setup.size.1 as i32);
             gl.disable(glow::SCISSOR_TEST);
             gl.disable(glow::BLEND);
             gl.enable(glow::MULTISAMPLE);
@@ -83,13 +201,14 @@ impl GlBackend {
             gl.blend_equation(glow::FUNC_ADD);
 
             gl.use_program(Some(program));
-            if pbr {
-                let lighting = PbrLighting::for_frame(scene, view);
+            if let (true, Some(lighting)) = (pbr, setup.lighting) {
                 pbr::set_frame_uniforms(
                     gl,
                     &self.pbr_uniforms,
-                    &lighting,
+                    lighting,
                     self.gpu.environment.as_ref(),
+                    self.gpu.brdf,
+                    setup.backdrop,
                 );
             }
             gl.uniform_3_f32_slice(u.to_light.as_ref(), &view.to_light.to_array());
@@ -109,6 +228,11 @@ impl GlBackend {
                 let mesh = &scene.meshes[draw.mesh];
                 let gpu_mesh = &self.gpu.meshes[draw.mesh];
                 let material = scene.draw_material(draw.mesh, &unlit);
+                if setup.backdrop_pass
+                    && (material.has_transmission() || material.alpha_mode == AlphaMode::Blend)
+                {
+                    continue;
+                }
                 stats.draws += 1;
                 stats.triangles_in += mesh.primitive_count() as u64;
                 if gpu_mesh.index_count == 0 {
@@ -178,7 +302,7 @@ impl GlBackend {
                     }
                 }
                 if pbr {
-                    self.set_pbr_draw_uniforms(draw, material, mesh);
+                    self.set_pbr_draw_uniforms(draw, material, mesh, setup.backdrop);
                 }
                 gl.active_texture(glow::TEXTURE0);
                 match material.base_color_texture {
@@ -214,7 +338,9 @@ impl GlBackend {
     /// The PBR program's uniforms and textures of one draw: the model matrix and whether it
     /// mirrors, the material's metallic, roughness, normal scale and occlusion strength, its
     /// PBR textures on their units with the samplers of the mesh's material, the texture
-    /// coordinate set of every texture, and whether the mesh has tangents.
+    /// coordinate set of every texture, whether the mesh has tangents, and — for a
+    /// transmissive material in a frame with a `backdrop` — its transmission, thickness and
+    /// the rules' [`Volume`] constants.
     ///
     /// # Safety
     /// `self.gl` must be current on this thread with the PBR program in use; `material` must be
@@ -222,9 +348,10 @@ impl GlBackend {
     /// were validated.
     unsafe fn set_pbr_draw_uniforms(
         &self,
-        draw: &kantele_rules::scene::Draw,
+        draw: &Draw,
         material: &Material,
         mesh: &Mesh,
+        backdrop: Option<&GpuBackdrop>,
     ) {
         let gl = &self.gl;
         let u = &self.pbr_uniforms;
@@ -242,11 +369,21 @@ impl GlBackend {
             0,
             0,
             0,
+            0,
+            0,
         ];
-        // The shader reads the first eight (not yet transmission and thickness).
-        for (k, binding) in material.pbr_textures().into_iter().take(8).enumerate() {
+        for (k, binding) in material.pbr_textures().into_iter().enumerate() {
             sets[2 + k] = set(binding);
         }
+        let volume = backdrop.filter(|_| material.has_transmission()).map(|b| {
+            Volume::new(
+                material.ior,
+                material.attenuation_color,
+                material.attenuation_distance,
+                &draw.model,
+                &b.backdrop,
+            )
+        });
         let coat_normal = material
             .clearcoat_normal_texture
             .filter(|_| material.has_clearcoat());
@@ -270,6 +407,17 @@ impl GlBackend {
                 u.clearcoat_normal_scale.as_ref(),
                 material.clearcoat_normal_scale,
             );
+            gl.uniform_1_i32(u.transmissive.as_ref(), volume.is_some() as i32);
+            if let Some(volume) = volume {
+                let ior_scale = (2.0 * volume.ior - 2.0).clamp(0.0, 1.0);
+                gl.uniform_1_f32(u.transmission.as_ref(), material.transmission);
+                gl.uniform_1_f32(u.thickness.as_ref(), material.thickness);
+                gl.uniform_1_f32(u.eta.as_ref(), 1.0 / volume.ior);
+                gl.uniform_1_f32(u.ior_scale.as_ref(), ior_scale);
+                gl.uniform_3_f32_slice(u.volume_scale.as_ref(), &volume.scale.to_array());
+                gl.uniform_3_f32_slice(u.attenuation.as_ref(), &volume.attenuation.to_array());
+                gl.uniform_1_f32(u.lod_scale.as_ref(), volume.lod_scale);
+            }
             for (k, ((binding, sampler), [has, _])) in material
                 .pbr_textures()
                 .into_iter()

@@ -65,8 +65,20 @@
 //!   the derivative towards increasing image row, as the CPU's). The environment is uploaded
 //!   at `load`: the SH coefficients are uniforms, the six pre-filtered octahedral levels share
 //!   one `GL_RGB32F` atlas and the split-sum table is a `GL_RG32F` texture, all read with
-//!   `texelFetch` and the rules' own bilinear arithmetic, never GL's filtering. The normal pass
-//!   writes the normal-mapped normal.
+//!   `texelFetch` and the rules' own bilinear arithmetic, never GL's filtering; the split-sum
+//!   table is uploaded for every PBR scene (transmission reads it without an environment). The
+//!   normal pass writes the normal-mapped normal.
+//! - **Transmission** (`KHR_materials_transmission`, `KHR_materials_volume`). A PBR colour
+//!   frame with a transmissive draw first draws its backdrop as the rules define it
+//!   (`kantele_rules::shade::transmission`): the draws neither transmissive nor blended, no
+//!   tone map, exposure 1, at `backdrop_size`, one sample, into a `GL_RGBA32F` framebuffer. It
+//!   is read back into the rules' `Backdrop`, whose own box-filtered chain is uploaded level by
+//!   level as a `GL_RGB32F` texture (explicit base and max levels, top row at `t = 0`), so both
+//!   backends filter the same texels; the frame then reads it with `textureLod`
+//!   (`GL_LINEAR_MIPMAP_LINEAR`, clamped to the edge) at the refracted exit point projected by
+//!   the frame's view-projection. Each transmissive draw's `Volume` (index of refraction,
+//!   scale, Beer coefficients, level-of-detail scale) is computed on the host by the rules.
+//!   Other draws and frames are drawn as before.
 //! - **Passes.** [`Pass::Normals`] writes the world normal after two-sided flipping, alpha 1;
 //!   [`Pass::Ids`] writes `(node_index + 1, gl_PrimitiveID + 1, draw index + 1, 1)`. Both clear to
 //!   0 and never blend; MASK discards as in the colour pass and BLEND geometry is drawn without

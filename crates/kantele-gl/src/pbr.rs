@@ -10,8 +10,16 @@
 //! weights computed in the shader as the CPU computes them (never GL's filtering). The levels
 //! share one `GL_RGB32F` atlas, stacked from level 0 at row 0 (see
 //! [`crate::resources::GpuEnvironment`]).
+//!
+//! Transmission (`kantele_rules::shade::transmission`) follows the rules the same way: the
+//! refracted path, the exit point's place in the backdrop, Beer's law, the punctual lights'
+//! transmitted lobe and the backdrop term of `pbr::shade`. Its per-draw constants (the rules'
+//! `Volume`: `1 / ior`, the model's scale, the Beer coefficients, the level-of-detail scale)
+//! come from the host; the backdrop is read with `textureLod` on the rules' own mip chain
+//! ([`crate::resources::GpuBackdrop`]), trilinear as `Backdrop::sample_lanes`. A draw without
+//! transmission (`u_transmissive` false) takes none of these branches.
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use glow::HasContext;
 use kantele_rules::shade::environment::{
     EnvironmentLight, BRDF_TABLE_SIZE, SH_Y0, SH_Y1, SH_Y2, SH_Y20, SH_Y22, SPECULAR_LEVELS,
@@ -22,12 +30,12 @@ use kantele_rules::shade::pbr::{
 };
 
 use crate::program::{uniforms, Uniforms};
-use crate::resources::GpuEnvironment;
+use crate::resources::{GpuBackdrop, GpuEnvironment};
 
 /// The program's material textures besides the base colour and emissive ones, in the order of
 /// [`Material::pbr_textures`](kantele_rules::scene::Material::pbr_textures): the names of
 /// their `u_has_*` flag and sampler uniforms. Texture `k` is on unit [`FIRST_PBR_UNIT`] + `k`.
-pub(crate) const PBR_TEXTURES: [(&str, &str); 8] = [
+pub(crate) const PBR_TEXTURES: [(&str, &str); 10] = [
     (
         "u_has_metallic_roughness_texture",
         "u_metallic_roughness_texture",
@@ -45,6 +53,8 @@ pub(crate) const PBR_TEXTURES: [(&str, &str); 8] = [
         "u_has_clearcoat_normal_texture",
         "u_clearcoat_normal_texture",
     ),
+    ("u_has_transmission_texture", "u_transmission_texture"),
+    ("u_has_thickness_texture", "u_thickness_texture"),
 ];
 /// Texture unit of the first of [`PBR_TEXTURES`] (0 and 1 are the base colour and emissive).
 pub(crate) const FIRST_PBR_UNIT: u32 = 2;
@@ -52,6 +62,9 @@ pub(crate) const FIRST_PBR_UNIT: u32 = 2;
 pub(crate) const UNIT_ENVIRONMENT: u32 = FIRST_PBR_UNIT + PBR_TEXTURES.len() as u32;
 /// Texture unit of the split-sum table.
 pub(crate) const UNIT_BRDF: u32 = UNIT_ENVIRONMENT + 1;
+/// Texture unit of the frame's backdrop (transmission). With it the fragment shader reads 15
+/// samplers, within OpenGL 3.3's guaranteed 16.
+pub(crate) const UNIT_BACKDROP: u32 = UNIT_BRDF + 1;
 
 /// The vertex shader: the Lambert program's, plus the world position, the second texture
 /// coordinate set and the world tangent (PbrShader's vertex stage) for the fragment shader.
@@ -101,8 +114,8 @@ in vec4 v_tangent;
 
 // The texture coordinate set (0 or 1) each texture reads, in the CPU shader's slot order:
 // base colour, emissive, metallic-roughness, normal, occlusion, specular, specular colour,
-// clear coat, clear-coat roughness, clear-coat normal.
-uniform int u_texcoord_set[10];
+// clear coat, clear-coat roughness, clear-coat normal, transmission, thickness.
+uniform int u_texcoord_set[12];
 // The set whose derivatives orient the tangent frame without mesh tangents.
 uniform int u_frame_set;
 // The mesh has tangents (else the derivative frame).
@@ -149,6 +162,27 @@ uniform sampler2D u_clearcoat_roughness_texture;
 uniform bool u_has_clearcoat_normal_texture;
 uniform sampler2D u_clearcoat_normal_texture;
 uniform float u_clearcoat_normal_scale;
+// KHR_materials_transmission and KHR_materials_volume (u_transmissive false: no transmission,
+// or no backdrop in this frame).
+uniform bool u_transmissive;
+uniform float u_transmission;
+uniform bool u_has_transmission_texture;
+uniform sampler2D u_transmission_texture;
+uniform float u_thickness;
+uniform bool u_has_thickness_texture;
+uniform sampler2D u_thickness_texture;
+// transmission::Volume, computed on the host: 1 / ior, clamp(2 ior - 2, 0, 1), the model's
+// scale per axis, Beer's law in base 2 per channel, the level of detail per unit of roughness.
+uniform float u_eta;
+uniform float u_ior_scale;
+uniform vec3 u_volume_scale;
+uniform vec3 u_attenuation;
+uniform float u_lod_scale;
+// transmission::TransmissionView: the backdrop's chain (RGB32F, row 0 at the top is t = 0,
+// trilinear, clamped to the edge), its last level, and the frame's view-projection (unflipped).
+uniform sampler2D u_backdrop;
+uniform float u_backdrop_last_level;
+uniform mat4 u_backdrop_view_projection;
 
 // PbrLighting: the eye, the punctual lights (FrameLight, as u_punctual_*: u_light_color is
 // the Lambert program's), exposure scale and tone map.
@@ -238,6 +272,9 @@ struct Surface {
     float coat_factor;
     float coat_roughness;
     vec3 coat_n;
+    bool transmission;
+    float transmission_factor;
+    float thickness;
 };
 
 // pbr::light_arrival: the unit vector towards light i and the attenuation.
@@ -265,8 +302,49 @@ void light_arrival(int i, vec3 position, out vec3 l, out float attenuation) {
     attenuation = is_finite(a) ? a : 0.0;
 }
 
-// pbr::punctual: light i on the surface, and on its coat (into `coat`).
-vec3 punctual(int i, Surface s, vec3 view, float alpha, out vec3 coat) {
+// transmission::attenuate: `light` after travelling along `path` inside the volume.
+vec3 attenuate(vec3 light, vec3 path) {
+    if (u_attenuation == vec3(0.0)) {
+        return light;
+    }
+    float distance = sqrt(dot3(path, path));
+    vec3 out_ = light;
+    for (int c = 0; c < 3; c++) {
+        if (u_attenuation[c] > 0.0) {
+            out_[c] = light[c] * exp2(clamp(-(u_attenuation[c] * distance), -126.0, 0.0));
+        }
+    }
+    return out_;
+}
+
+// pbr::punctual_transmission: the light of light i that the surface lets through towards
+// `view`, its falloff taken where the refracted view ray leaves the volume (`path`).
+vec3 punctual_transmission(int i, Surface s, vec3 view, float alpha, vec3 path) {
+    vec3 n = s.n;
+    vec3 exit_ = s.position + path;
+    vec3 l;
+    float attenuation;
+    light_arrival(i, exit_, l, attenuation);
+    // The light's direction mirrored in the surface's plane: L - 2 (N.L) N.
+    float n_dot_l = dot3(n, l);
+    float twice = n_dot_l + n_dot_l;
+    vec3 mirrored = normalize3(l - twice * n);
+    vec3 h = normalize3(view + mirrored);
+    float n_dot_m = clamp01(dot3(n, mirrored));
+    float n_dot_v = clamp01(dot3(n, view));
+    float n_dot_h = clamp01(dot3(n, h));
+    float v_dot_h = clamp01(dot3(view, h));
+    float alpha_t = max(alpha * u_ior_scale, TRANSMISSION_ALPHA_FLOOR);
+    float dv = ggx_d_times_v(alpha_t, n_dot_m, n_dot_v, n_dot_h);
+    vec3 f = schlick(s.f0, s.f90, v_dot_h);
+    float weight = attenuation * n_dot_m * dv * s.transmission_factor;
+    vec3 through = u_punctual_color[i] * weight * (1.0 - f) * s.c_diff;
+    return attenuate(through, path);
+}
+
+// pbr::punctual: light i on the surface, and on its coat (into `coat`); `path` is the
+// refracted path through a transmissive surface's volume.
+vec3 punctual(int i, Surface s, vec3 view, float alpha, vec3 path, out vec3 coat) {
     vec3 l;
     float attenuation;
     light_arrival(i, s.position, l, attenuation);
@@ -279,7 +357,16 @@ vec3 punctual(int i, Surface s, vec3 view, float alpha, out vec3 coat) {
     vec3 f = schlick(s.f0, s.f90, v_dot_h);
     float dv = ggx_d_times_v(alpha, n_dot_l, n_dot_v, n_dot_h);
     float scale = attenuation * n_dot_l;
-    vec3 brdf = (1.0 - f) * s.c_diff * INV_PI + f * dv;
+    vec3 brdf;
+    vec3 through = vec3(0.0);
+    if (s.transmission) {
+        // Transmission takes its part of the diffuse light, and adds the light from behind.
+        through = punctual_transmission(i, s, view, alpha, path);
+        float kept = 1.0 - s.transmission_factor;
+        brdf = (1.0 - f) * s.c_diff * INV_PI * kept + f * dv;
+    } else {
+        brdf = (1.0 - f) * s.c_diff * INV_PI + f * dv;
+    }
     coat = vec3(0.0);
     if (s.coat) {
         vec3 nc = s.coat_n;
@@ -290,6 +377,9 @@ vec3 punctual(int i, Surface s, vec3 view, float alpha, out vec3 coat) {
         float c_dv = ggx_d_times_v(clamped * clamped, c_n_dot_l, c_n_dot_v, c_n_dot_h);
         float lobe = attenuation * c_n_dot_l * coat_fresnel(v_dot_h) * c_dv;
         coat = u_punctual_color[i] * lobe;
+    }
+    if (s.transmission) {
+        return u_punctual_color[i] * scale * brdf + through;
     }
     return u_punctual_color[i] * scale * brdf;
 }
@@ -428,6 +518,9 @@ vec3 image_based(Surface s, vec3 view, out vec3 coat) {
     float weight = s.occlusion * u_environment_intensity;
     vec3 fss_ess = s.f0 * ab.x + s.f90 * ab.y;
     vec3 diffuse = irradiance_ * s.c_diff * (1.0 - fss_ess);
+    if (s.transmission) {
+        diffuse = diffuse * (1.0 - s.transmission_factor);
+    }
     coat = vec3(0.0);
     if (s.coat) {
         vec3 coat_specular;
@@ -439,6 +532,42 @@ vec3 image_based(Surface s, vec3 view, out vec3 coat) {
     return (diffuse + specular_ * fss_ess) * weight;
 }
 
+// transmission::refraction_path: the view ray refracted at n by 1 / ior (GLSL's refract of
+// -view; total internal reflection gives no path), normalised, times the thickness and the
+// draw's scale per axis. Zero for a thin wall.
+vec3 refraction_path(Surface s, vec3 view) {
+    vec3 n = s.n;
+    float eta = u_eta;
+    // i = -view; k = 1 - eta^2 (1 - (n.i)^2); t = eta i - (eta (n.i) + sqrt(k)) n.
+    float n_dot_i = -dot3(n, view);
+    float k = 1.0 - eta * eta * (1.0 - n_dot_i * n_dot_i);
+    float along_n = eta * n_dot_i + sqrt(max(k, 0.0));
+    vec3 t = normalize3(-(eta * view) - along_n * n);
+    vec3 length_ = s.thickness * u_volume_scale;
+    return k >= 0.0 ? t * length_ : vec3(0.0);
+}
+
+// transmission::backdrop_uv: where world point p lies in the backdrop, (u, v) from 0 to 1 left
+// to right and top to bottom (the texture's s and t: its row 0 is the top).
+vec2 backdrop_uv(vec3 p) {
+    mat4 m = u_backdrop_view_projection;
+    float x = m[0][0] * p.x + m[1][0] * p.y + m[2][0] * p.z + m[3][0];
+    float y = m[0][1] * p.x + m[1][1] * p.y + m[2][1] * p.z + m[3][1];
+    float w = m[0][3] * p.x + m[1][3] * p.y + m[2][3] * p.z + m[3][3];
+    w = max(w, 1e-6);
+    return vec2(0.5 + 0.5 * (x / w), 0.5 - 0.5 * (y / w));
+}
+
+// transmission::transmitted_light: the backdrop where the refracted view ray leaves the
+// volume, blurred for the roughness, dimmed along the path.
+vec3 transmitted_light(Surface s, vec3 path) {
+    vec2 uv = backdrop_uv(s.position + path);
+    float lod = s.roughness * u_lod_scale;
+    lod = is_finite(lod) ? clamp(lod, 0.0, u_backdrop_last_level) : 0.0;
+    vec3 light = textureLod(u_backdrop, uv, lod).rgb;
+    return attenuate(light, path);
+}
+
 // pbr::shade: the linear colour before exposure and tone mapping, emission and coat included.
 vec3 shade(Surface s, vec3 emissive) {
     vec3 view = normalize3(u_eye - s.position);
@@ -446,15 +575,25 @@ vec3 shade(Surface s, vec3 emissive) {
     float alpha = clamped * clamped;
     vec3 color = vec3(0.0);
     vec3 coat_color = vec3(0.0);
+    vec3 path = s.transmission ? refraction_path(s, view) : vec3(0.0);
     for (int i = 0; i < u_punctual_count; i++) {
         vec3 coat;
-        color = color + punctual(i, s, view, alpha, coat);
+        color = color + punctual(i, s, view, alpha, path, coat);
         coat_color = coat_color + coat;
     }
     if (u_has_environment) {
         vec3 coat;
         color = color + image_based(s, view, coat);
         coat_color = coat_color + coat;
+    }
+    if (s.transmission) {
+        // The backdrop replaces the part `transmission_factor` of the dielectric's diffuse
+        // light, with the same room left by the specular reflection.
+        vec3 light = transmitted_light(s, path);
+        float n_dot_v = clamp01(dot3(s.n, view));
+        vec2 ab = brdf_ab(n_dot_v, s.roughness);
+        vec3 fss_ess = s.f0 * ab.x + s.f90 * ab.y;
+        color = color + s.transmission_factor * s.c_diff * (1.0 - fss_ess) * light;
     }
     color = color + emissive;
     if (s.coat) {
@@ -566,6 +705,14 @@ void main() {
     if (u_has_clearcoat_normal_texture) {
         clearcoat_normal_texel = texture(u_clearcoat_normal_texture, uv(9));
     }
+    vec4 transmission_texel = vec4(1.0);
+    if (u_has_transmission_texture) {
+        transmission_texel = texture(u_transmission_texture, uv(10));
+    }
+    vec4 thickness_texel = vec4(1.0);
+    if (u_has_thickness_texture) {
+        thickness_texel = texture(u_thickness_texture, uv(11));
+    }
     // The projection is y-flipped (window row 0 = image row 0), so dFdy is the derivative
     // towards increasing image row, as the CPU's.
     vec3 dp_dx = dFdx(v_position);
@@ -674,6 +821,17 @@ void main() {
         s.coat_factor = clamp01(coat_factor);
         s.coat_roughness = clamp01(coat_roughness);
         s.coat_n = coat_n;
+        s.transmission = u_transmissive;
+        float transmission = u_transmission;
+        if (u_has_transmission_texture) {
+            transmission = transmission * transmission_texel.r;
+        }
+        float thickness = u_thickness;
+        if (u_has_thickness_texture) {
+            thickness = thickness * thickness_texel.g;
+        }
+        s.transmission_factor = clamp01(transmission);
+        s.thickness = max(thickness, 0.0);
         rgb = shade(s, emissive);
     }
     rgb = tonemap(rgb);
@@ -696,6 +854,11 @@ pub(crate) fn fragment_source() -> String {
     source += &float("INV_PI", std::f32::consts::FRAC_1_PI);
     source += &float("DIELECTRIC_F0", DIELECTRIC_F0);
     source += &float("MIN_PUNCTUAL_ROUGHNESS", MIN_PUNCTUAL_ROUGHNESS);
+    // The transmitted lobe's narrowest alpha (pbr::punctual_transmission).
+    source += &float(
+        "TRANSMISSION_ALPHA_FLOOR",
+        MIN_PUNCTUAL_ROUGHNESS * MIN_PUNCTUAL_ROUGHNESS,
+    );
     source += &float("START_COMPRESSION", PBR_NEUTRAL_START_COMPRESSION);
     source += &float("DESATURATION", PBR_NEUTRAL_DESATURATION);
     // Spherical harmonics of bands 0–2.
@@ -734,6 +897,17 @@ pub(crate) struct PbrUniforms {
     pub(crate) clearcoat: Option<glow::UniformLocation>,
     pub(crate) clearcoat_roughness: Option<glow::UniformLocation>,
     pub(crate) clearcoat_normal_scale: Option<glow::UniformLocation>,
+    pub(crate) transmissive: Option<glow::UniformLocation>,
+    pub(crate) transmission: Option<glow::UniformLocation>,
+    pub(crate) thickness: Option<glow::UniformLocation>,
+    pub(crate) eta: Option<glow::UniformLocation>,
+    pub(crate) ior_scale: Option<glow::UniformLocation>,
+    pub(crate) volume_scale: Option<glow::UniformLocation>,
+    pub(crate) attenuation: Option<glow::UniformLocation>,
+    pub(crate) lod_scale: Option<glow::UniformLocation>,
+    pub(crate) backdrop: Option<glow::UniformLocation>,
+    pub(crate) backdrop_last_level: Option<glow::UniformLocation>,
+    pub(crate) backdrop_view_projection: Option<glow::UniformLocation>,
     pub(crate) tangent_sign: Option<glow::UniformLocation>,
     pub(crate) texcoord_sets: Option<glow::UniformLocation>,
     pub(crate) frame_set: Option<glow::UniformLocation>,
@@ -787,6 +961,17 @@ pub(crate) unsafe fn pbr_uniforms(gl: &glow::Context, program: glow::Program) ->
         clearcoat: at("u_clearcoat"),
         clearcoat_roughness: at("u_clearcoat_roughness"),
         clearcoat_normal_scale: at("u_clearcoat_normal_scale"),
+        transmissive: at("u_transmissive"),
+        transmission: at("u_transmission"),
+        thickness: at("u_thickness"),
+        eta: at("u_eta"),
+        ior_scale: at("u_ior_scale"),
+        volume_scale: at("u_volume_scale"),
+        attenuation: at("u_attenuation"),
+        lod_scale: at("u_lod_scale"),
+        backdrop: at("u_backdrop"),
+        backdrop_last_level: at("u_backdrop_last_level"),
+        backdrop_view_projection: at("u_backdrop_view_projection"),
         tangent_sign: at("u_tangent_sign"),
         texcoord_sets: at("u_texcoord_set"),
         frame_set: at("u_frame_set"),
@@ -855,17 +1040,21 @@ impl LightArrays {
 }
 
 /// Sets the frame's uniforms of the PBR program (in use): texture units, the eye, the lights,
-/// exposure and tone map, and the environment, whose atlas and table it binds to
-/// [`UNIT_ENVIRONMENT`] and [`UNIT_BRDF`] (leaving unit 0 active).
+/// exposure and tone map, the environment, whose atlas it binds to [`UNIT_ENVIRONMENT`], the
+/// split-sum table (`brdf`, on [`UNIT_BRDF`]), and the backdrop of a frame with transmission
+/// (on [`UNIT_BACKDROP`], with `lighting.transmission`'s view-projection), leaving unit 0
+/// active.
 ///
 /// # Safety
-/// `gl` must be current on this thread with the PBR program in use; `environment` must be
-/// its objects.
+/// `gl` must be current on this thread with the PBR program in use; `environment`, `brdf`
+/// and `backdrop` must be its objects.
 pub(crate) unsafe fn set_frame_uniforms(
     gl: &glow::Context,
     u: &PbrUniforms,
     lighting: &PbrLighting,
     environment: Option<&GpuEnvironment>,
+    brdf: Option<glow::Texture>,
+    backdrop: Option<&GpuBackdrop>,
 ) {
     let lights = LightArrays::new(&lighting.lights);
     let unit = |unit: u32| unit as i32;
@@ -876,6 +1065,7 @@ pub(crate) unsafe fn set_frame_uniforms(
         }
         gl.uniform_1_i32(u.environment.as_ref(), unit(UNIT_ENVIRONMENT));
         gl.uniform_1_i32(u.brdf.as_ref(), unit(UNIT_BRDF));
+        gl.uniform_1_i32(u.backdrop.as_ref(), unit(UNIT_BACKDROP));
         gl.uniform_3_f32_slice(u.eye.as_ref(), &lighting.eye.to_array());
         gl.uniform_1_i32(u.light_count.as_ref(), lights.count);
         gl.uniform_3_f32_slice(u.light_color.as_ref(), &lights.color);
@@ -897,8 +1087,22 @@ pub(crate) unsafe fn set_frame_uniforms(
         gl.bind_texture(glow::TEXTURE_2D, environment.map(|e| e.atlas));
         gl.active_texture(glow::TEXTURE0 + UNIT_BRDF);
         gl.bind_sampler(UNIT_BRDF, None);
-        gl.bind_texture(glow::TEXTURE_2D, environment.map(|e| e.brdf));
+        gl.bind_texture(glow::TEXTURE_2D, brdf);
+        gl.active_texture(glow::TEXTURE0 + UNIT_BACKDROP);
+        gl.bind_sampler(UNIT_BACKDROP, None);
+        gl.bind_texture(glow::TEXTURE_2D, backdrop.map(|b| b.texture));
         gl.active_texture(glow::TEXTURE0);
+        let view_projection = lighting
+            .transmission
+            .as_ref()
+            .map_or(Mat4::IDENTITY, |t| t.view_projection);
+        gl.uniform_matrix_4_f32_slice(
+            u.backdrop_view_projection.as_ref(),
+            false,
+            &view_projection.to_cols_array(),
+        );
+        let last_level = backdrop.map_or(0, |b| b.backdrop.level_count() - 1);
+        gl.uniform_1_f32(u.backdrop_last_level.as_ref(), last_level as f32);
         if let Some((light, maps)) = light_and_maps {
             set_environment_uniforms(gl, u, light, maps);
         }

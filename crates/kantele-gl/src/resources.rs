@@ -1,7 +1,8 @@
 //! Scene data in GL objects: one vertex array + vertex buffer + index buffer per mesh, one RGBA8 /
 //! SRGB8_ALPHA8 texture with its complete mip chain per texture, one sampler object per texture
-//! binding of a material, and for a PBR scene with an environment its pre-filtered levels and
-//! split-sum table as float textures.
+//! binding of a material, for a PBR scene the split-sum table and (with an environment) its
+//! pre-filtered levels as float textures; and a frame's transmission backdrop, uploaded with
+//! the rules' own mip chain.
 
 use glow::HasContext;
 use kantele_rules::scene::{Material, Mesh, Scene, Shading};
@@ -9,6 +10,7 @@ use kantele_rules::shade::environment::{
     brdf_table, Environment, BRDF_TABLE_SIZE, SPECULAR_LEVELS,
 };
 use kantele_rules::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
+use kantele_rules::shade::transmission::Backdrop;
 use kantele_rules::vertex::{PbrVertex, StandardVertex};
 
 /// Floats per vertex: position 3, normal 3, texcoord 2, colour 4.
@@ -37,18 +39,19 @@ pub(crate) struct GpuScene {
     pub(crate) emissive_samplers: Vec<Option<glow::Sampler>>,
     /// Per material: the sampler objects of its PBR textures ([`Material::pbr_textures`]),
     /// where it has them.
-    pub(crate) pbr_samplers: Vec<[Option<glow::Sampler>; 8]>,
+    pub(crate) pbr_samplers: Vec<[Option<glow::Sampler>; 10]>,
     /// The environment of a PBR scene, if it has one.
     pub(crate) environment: Option<GpuEnvironment>,
+    /// The split-sum table of a PBR scene ([`upload_brdf_table`]): image-based light and
+    /// transmission read it.
+    pub(crate) brdf: Option<glow::Texture>,
 }
 
 /// An environment on the GPU, read by the PBR program with `texelFetch` only: the
 /// pre-filtered levels of [`Environment::levels`] stacked in one `GL_RGB32F` atlas (level 0 at
-/// row 0, each level `(size + 2)²` texels with its border, at column 0), and the split-sum table
-/// of [`brdf_table`] as a `BRDF_TABLE_SIZE²` `GL_RG32F` texture (x: `NdotV`, y: roughness).
+/// row 0, each level `(size + 2)²` texels with its border, at column 0).
 pub(crate) struct GpuEnvironment {
     pub(crate) atlas: glow::Texture,
-    pub(crate) brdf: glow::Texture,
     /// The atlas row where each level starts.
     pub(crate) rows: [i32; SPECULAR_LEVELS],
     /// Each level's size without its border.
@@ -313,7 +316,7 @@ unsafe fn upload_float_texture(
     }
 }
 
-/// Uploads an environment's levels and the split-sum table.
+/// Uploads an environment's levels.
 ///
 /// # Safety
 /// `gl` must be current on this thread.
@@ -322,24 +325,88 @@ pub(crate) unsafe fn upload_environment(
     environment: &Environment,
 ) -> Result<GpuEnvironment, String> {
     let (width, height, texels, rows, sizes) = environment_atlas(environment)?;
-    let table: Vec<f32> = brdf_table().iter().flatten().copied().collect();
-    // SAFETY: forwarded caller's contract; the slices hold the declared texel counts.
+    // SAFETY: forwarded caller's contract; the slice holds the declared texel count.
     unsafe {
         let atlas = upload_float_texture(gl, glow::RGB32F, glow::RGB, (width, height), &texels)?;
-        let size = (BRDF_TABLE_SIZE, BRDF_TABLE_SIZE);
-        let brdf = match upload_float_texture(gl, glow::RG32F, glow::RG, size, &table) {
-            Ok(brdf) => brdf,
-            Err(e) => {
-                gl.delete_texture(atlas);
-                return Err(e);
-            }
-        };
-        Ok(GpuEnvironment {
-            atlas,
-            brdf,
-            rows,
-            sizes,
-        })
+        Ok(GpuEnvironment { atlas, rows, sizes })
+    }
+}
+
+/// Uploads the split-sum table of [`brdf_table`] as a `BRDF_TABLE_SIZE²` `GL_RG32F` texture
+/// (x: `NdotV`, y: roughness), read by `texelFetch` only.
+///
+/// # Safety
+/// `gl` must be current on this thread.
+pub(crate) unsafe fn upload_brdf_table(gl: &glow::Context) -> Result<glow::Texture, String> {
+    let table: Vec<f32> = brdf_table().iter().flatten().copied().collect();
+    let size = (BRDF_TABLE_SIZE, BRDF_TABLE_SIZE);
+    // SAFETY: forwarded caller's contract; the table holds BRDF_TABLE_SIZE² RG texels.
+    unsafe { upload_float_texture(gl, glow::RG32F, glow::RG, size, &table) }
+}
+
+/// A frame's backdrop on the GPU: every level of the rules' chain ([`Backdrop::level`]) in one
+/// `GL_RGB32F` texture with explicit levels, rows in memory order (the backdrop's top row is
+/// GL's `t = 0` row, where the rules' `v = 0` points), sampled trilinearly
+/// (`GL_LINEAR_MIPMAP_LINEAR`, `GL_LINEAR`) and clamped to the edge, as
+/// [`Backdrop::sample_lanes`] reads it.
+pub(crate) struct GpuBackdrop {
+    pub(crate) texture: glow::Texture,
+    /// The chain the texture holds (the rules read the same one).
+    pub(crate) backdrop: std::sync::Arc<Backdrop>,
+}
+
+/// Uploads `backdrop`'s levels.
+///
+/// # Safety
+/// `gl` must be current on this thread.
+pub(crate) unsafe fn upload_backdrop(
+    gl: &glow::Context,
+    backdrop: std::sync::Arc<Backdrop>,
+) -> Result<GpuBackdrop, String> {
+    let levels: Vec<(u32, u32, Vec<[f32; 3]>)> = (0..backdrop.level_count())
+        .map_while(|k| backdrop.level(k))
+        .collect();
+    let count = levels.len();
+    // SAFETY: the context is current (caller's contract); the texture is created here; each
+    // level's byte slice holds exactly width × height RGB f32 texels as declared, and rows of
+    // f32 texels are 4-byte aligned, so UNPACK_ALIGNMENT 4 adds no padding.
+    unsafe {
+        let max_size = gl.get_parameter_i32(glow::MAX_TEXTURE_SIZE);
+        let (width, height, _) = &levels[0];
+        if *width as i64 > max_size as i64 || *height as i64 > max_size as i64 {
+            return Err(format!(
+                "backdrop {width}x{height} exceeds GL_MAX_TEXTURE_SIZE {max_size}"
+            ));
+        }
+        let texture = gl.create_texture()?;
+        gl.bind_texture(glow::TEXTURE_2D, Some(texture));
+        gl.pixel_store_i32(glow::UNPACK_ALIGNMENT, 4);
+        gl.pixel_store_i32(glow::UNPACK_ROW_LENGTH, 0);
+        for (k, (width, height, texels)) in levels.iter().enumerate() {
+            gl.tex_image_2d(
+                glow::TEXTURE_2D,
+                k as i32,
+                glow::RGB32F as i32,
+                *width as i32,
+                *height as i32,
+                0,
+                glow::RGB,
+                glow::FLOAT,
+                glow::PixelUnpackData::Slice(Some(&f32_bytes(texels.iter().flatten().copied()))),
+            );
+        }
+        for (parameter, value) in [
+            (glow::TEXTURE_MIN_FILTER, glow::LINEAR_MIPMAP_LINEAR as i32),
+            (glow::TEXTURE_MAG_FILTER, glow::LINEAR as i32),
+            (glow::TEXTURE_WRAP_S, glow::CLAMP_TO_EDGE as i32),
+            (glow::TEXTURE_WRAP_T, glow::CLAMP_TO_EDGE as i32),
+            (glow::TEXTURE_BASE_LEVEL, 0),
+            (glow::TEXTURE_MAX_LEVEL, count as i32 - 1),
+        ] {
+            gl.tex_parameter_i32(glow::TEXTURE_2D, parameter, value);
+        }
+        gl.bind_texture(glow::TEXTURE_2D, None);
+        Ok(GpuBackdrop { texture, backdrop })
     }
 }
 
@@ -430,7 +497,7 @@ impl GpuScene {
                     None => None,
                 };
                 gpu.emissive_samplers.push(emissive);
-                let mut pbr = [None; 8];
+                let mut pbr = [None; 10];
                 for (slot, binding) in pbr.iter_mut().zip(material.pbr_textures()) {
                     if let Some(b) = binding {
                         // SAFETY: forwarded caller's contract.
@@ -438,6 +505,12 @@ impl GpuScene {
                     }
                 }
                 gpu.pbr_samplers.push(pbr);
+            }
+            if scene.shading == Shading::Pbr {
+                // SAFETY: forwarded caller's contract.
+                let brdf = unsafe { upload_brdf_table(gl) }
+                    .map_err(|e| format!("split-sum table: {e}"))?;
+                gpu.brdf = Some(brdf);
             }
             if let (Shading::Pbr, Some(light)) = (scene.shading, &scene.environment) {
                 // SAFETY: forwarded caller's contract.
@@ -484,7 +557,9 @@ impl GpuScene {
             }
             if let Some(e) = self.environment.take() {
                 gl.delete_texture(e.atlas);
-                gl.delete_texture(e.brdf);
+            }
+            if let Some(t) = self.brdf.take() {
+                gl.delete_texture(t);
             }
         }
     }

@@ -1,6 +1,7 @@
 //! The render target: the single-sample framebuffer frames are read from, the multisampled one
 //! colour frames are drawn into at 4× or 8×, their creation for a view's size and format, and the
-//! resolve between them.
+//! resolve between them; and the one-sample float framebuffer a frame's transmission backdrop
+//! is drawn into and read back from.
 
 use glow::HasContext;
 use kantele_rules::multisample::SampleCount;
@@ -234,5 +235,99 @@ impl GlBackend {
             gl.finish();
         }
         self.check("resolving the multisampled frame")
+    }
+}
+
+/// A one-sample `GL_RGBA32F` framebuffer with its depth, for a frame's backdrop.
+pub(crate) struct BackdropTarget {
+    pub(crate) framebuffer: glow::Framebuffer,
+    color: glow::Renderbuffer,
+    depth: glow::Renderbuffer,
+}
+
+impl GlBackend {
+    /// A `width × height` [`BackdropTarget`] (the colour format of the reference target,
+    /// whatever [`GlBackend::set_fast_target`] selects, and the target's depth format).
+    pub(crate) fn create_backdrop_target(
+        &self,
+        width: u32,
+        height: u32,
+    ) -> Result<BackdropTarget, RenderError> {
+        let gl = &self.gl;
+        // SAFETY: `gl` is current on this thread; the objects are created here and attached
+        // to the framebuffer created here.
+        unsafe {
+            let target = BackdropTarget {
+                framebuffer: gl.create_framebuffer().map_err(backend_error)?,
+                color: gl.create_renderbuffer().map_err(backend_error)?,
+                depth: gl.create_renderbuffer().map_err(backend_error)?,
+            };
+            gl.bind_framebuffer(glow::FRAMEBUFFER, Some(target.framebuffer));
+            let size = (width as i32, height as i32);
+            let single = SampleCount::X1;
+            let color = (target.color, glow::COLOR_ATTACHMENT0, glow::RGBA32F);
+            let depth = (target.depth, glow::DEPTH_ATTACHMENT, DEPTH_FORMAT);
+            for (renderbuffer, attachment, format) in [color, depth] {
+                attach_renderbuffer(gl, renderbuffer, attachment, format, single, size);
+            }
+            let status = gl.check_framebuffer_status(glow::FRAMEBUFFER);
+            if status != glow::FRAMEBUFFER_COMPLETE {
+                self.delete_backdrop_target(target);
+                return Err(backend_error(format!(
+                    "backdrop framebuffer {width}x{height} incomplete (status 0x{status:04X})"
+                )));
+            }
+            Ok(target)
+        }
+    }
+
+    /// Deletes a [`BackdropTarget`].
+    pub(crate) fn delete_backdrop_target(&self, target: BackdropTarget) {
+        // SAFETY: `gl` is current on this thread and the objects are ours, deleted once (the
+        // target is consumed).
+        unsafe {
+            self.gl.bind_framebuffer(glow::FRAMEBUFFER, None);
+            self.gl.delete_framebuffer(target.framebuffer);
+            self.gl.delete_renderbuffer(target.color);
+            self.gl.delete_renderbuffer(target.depth);
+        }
+    }
+
+    /// The `width × height` RGBA float colour of `framebuffer`'s first attachment, GL's row 0
+    /// first (the image's top row under the y-flipped projection).
+    pub(crate) fn read_color(
+        &self,
+        framebuffer: glow::Framebuffer,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<[f32; 4]>, RenderError> {
+        let mut color = vec![0u8; width as usize * height as usize * 16];
+        // SAFETY: `gl` is current on this thread; the framebuffer is ours; the buffer holds
+        // exactly width × height RGBA f32 values with PACK_ALIGNMENT 4 and no row length,
+        // which is what glReadPixels writes for this format.
+        unsafe {
+            let gl = &self.gl;
+            gl.bind_buffer(glow::PIXEL_PACK_BUFFER, None);
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(framebuffer));
+            gl.read_buffer(glow::COLOR_ATTACHMENT0);
+            gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
+            gl.pixel_store_i32(glow::PACK_ROW_LENGTH, 0);
+            gl.read_pixels(
+                0,
+                0,
+                width as i32,
+                height as i32,
+                glow::RGBA,
+                glow::FLOAT,
+                glow::PixelPackData::Slice(Some(&mut color)),
+            );
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, None);
+        }
+        self.check("reading the backdrop back")?;
+        let float = |b: &[u8]| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]);
+        Ok(color
+            .chunks_exact(16)
+            .map(|p| [0, 4, 8, 12].map(|o| float(&p[o..o + 4])))
+            .collect())
     }
 }
