@@ -271,7 +271,7 @@ fn checker(size: u32, cells: u32) -> Texture {
         .flat_map(|i| {
             let (x, y) = (i % size, i / size);
             let cell = (size / cells).max(1);
-            if (x / cell + y / cell) % 2 == 0 {
+            if (x / cell + y / cell).is_multiple_of(2) {
                 [232, 226, 210, 255]
             } else {
                 [46, 58, 74, 255]
