@@ -39,6 +39,18 @@ pub struct Backdrop {
     texel_bits: Vec<u32>,
 }
 
+/// Bytes a backdrop pixel costs while a frame is drawn: its target (linear RGBA and depth,
+/// `f32`: 20), the colour read back (16) and the mip chain (four words a texel, a third more
+/// for the smaller levels: 22).
+pub const BACKDROP_BYTES_PER_PIXEL: usize = 20 + 16 + 22;
+
+/// Bytes the backdrop of a `width` × `height` frame costs ([`BACKDROP_BYTES_PER_PIXEL`] at
+/// [`backdrop_size`]): what a frame memory budget sets aside for a scene with transmission.
+pub fn backdrop_bytes(width: u32, height: u32) -> usize {
+    let (w, h) = backdrop_size(width, height);
+    w as usize * h as usize * BACKDROP_BYTES_PER_PIXEL
+}
+
 /// The size of the backdrop of a `width` × `height` frame: the frame's, scaled down (keeping
 /// its aspect, at least 1 × 1) so that neither side exceeds [`MAX_BACKDROP_SIZE`].
 pub fn backdrop_size(width: u32, height: u32) -> (u32, u32) {
