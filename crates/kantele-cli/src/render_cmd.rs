@@ -12,6 +12,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
 use kantele::band::{plan_bands, TARGET_BYTES_PER_PIXEL};
 use kantele::scene::Scene;
+use kantele::shade::transmission::backdrop_bytes;
 use kantele::stats::FrameStats;
 use kantele::RenderError;
 use kantele_output::output::OutputSet;
@@ -397,7 +398,14 @@ impl SceneJob<'_> {
     ) -> Result<f64> {
         let (args, label, scene) = (self.args, &self.label, &self.scene);
         let (width, height) = (pose.width, pose.height);
-        let bands = plan_bands(width, height, BAND_BYTES_PER_PIXEL, frame_memory(args));
+        // A frame with transmission draws its whole backdrop first, whatever its bands.
+        let backdrop = if scene.has_transmission() {
+            backdrop_bytes(width, height)
+        } else {
+            0
+        };
+        let budget = frame_memory(args).saturating_sub(backdrop);
+        let bands = plan_bands(width, height, BAND_BYTES_PER_PIXEL, budget);
         if bands.len() > 1 {
             backend
                 .set_render_region(Some(bands[0].clone()))

@@ -593,6 +593,12 @@ impl Scene {
         order
     }
 
+    /// Whether colour frames of the scene draw a backdrop first: PBR shading with a
+    /// transmissive material ([`Material::has_transmission`]).
+    pub fn has_transmission(&self) -> bool {
+        self.shading == Shading::Pbr && self.materials.iter().any(Material::has_transmission)
+    }
+
     /// Unlit copies of the materials, for lines and points without normals: glTF 2.0 §3.7.2.1
     /// says they are drawn without lighting. Index `i` is material `i` with `unlit` set.
     pub fn unlit_materials(&self) -> Vec<Material> {

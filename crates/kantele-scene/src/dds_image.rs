@@ -134,6 +134,16 @@ impl TexelFormat {
         }
     }
 
+    /// The format's name in messages: the decoder's, or "24-bit RGB" / "24-bit BGR" for the
+    /// legacy 24-bit texels decoded here.
+    fn name(self) -> String {
+        match self.packed24 {
+            Some([0, _, _]) => "24-bit RGB".to_string(),
+            Some(_) => "24-bit BGR".to_string(),
+            None => format!("{:?}", self.format),
+        }
+    }
+
     /// Bytes a `width` × `height` level takes in the file: whole 4 × 4 blocks for the BC
     /// formats, 4 bytes a texel for the uncompressed ones (3 for the 24-bit ones).
     fn level_bytes(self, width: u32, height: u32) -> u64 {
@@ -358,9 +368,9 @@ impl<'a> DdsFile<'a> {
         let needed = texels.level_bytes(width, height);
         if (data.len() as u64) < needed {
             return Err(decode_error(format!(
-                "the DDS file is truncated: it holds {} bytes of texels, but a {width}x{height} {:?} image needs {needed}",
+                "the DDS file is truncated: it holds {} bytes of texels, but a {width}x{height} {} image needs {needed}",
                 data.len(),
-                texels.format
+                texels.name()
             )));
         }
         Ok(file)
@@ -695,7 +705,8 @@ mod tests {
     }
 
     /// A 24-bit file's rows are three bytes a texel, unpadded, level after level: a file of
-    /// three levels one byte short of the last is read from level 0 alone.
+    /// three levels one byte short of the last is read from level 0 alone, one short of level 0
+    /// is refused naming its layout.
     #[test]
     fn a_24_bit_chain_is_read_level_by_level() {
         let level = |[r, g, b]: [u8; 3], texels: usize| [b, g, r].repeat(texels);
@@ -713,6 +724,12 @@ mod tests {
         let short = &file[..file.len() - 1];
         let texture = decode(short, ColorSpace::Linear).expect("level 0 alone");
         assert_eq!(level_texels(&texture, 0), vec![[200, 10, 0, 255]; 12]);
+        // Short of level 0: the message names the layout the file declares.
+        let e = decode(&file[..file.len() - 20], ColorSpace::Linear).unwrap_err();
+        assert!(
+            e.contains("truncated") && e.contains("4x3 24-bit BGR"),
+            "{e}"
+        );
         // Other 24-bit layouts are refused, naming what is read.
         let other = dds(
             4,

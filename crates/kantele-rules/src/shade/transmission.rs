@@ -39,6 +39,18 @@ pub struct Backdrop {
     texel_bits: Vec<u32>,
 }
 
+/// Bytes a backdrop pixel costs while a frame is drawn: its target (linear RGBA and depth,
+/// `f32`: 20), the colour read back (16) and the mip chain (four words a texel, a third more
+/// for the smaller levels: 22).
+pub const BACKDROP_BYTES_PER_PIXEL: usize = 20 + 16 + 22;
+
+/// Bytes the backdrop of a `width` × `height` frame costs ([`BACKDROP_BYTES_PER_PIXEL`] at
+/// [`backdrop_size`]): what a frame memory budget sets aside for a scene with transmission.
+pub fn backdrop_bytes(width: u32, height: u32) -> usize {
+    let (w, h) = backdrop_size(width, height);
+    w as usize * h as usize * BACKDROP_BYTES_PER_PIXEL
+}
+
 /// The size of the backdrop of a `width` × `height` frame: the frame's, scaled down (keeping
 /// its aspect, at least 1 × 1) so that neither side exceeds [`MAX_BACKDROP_SIZE`].
 pub fn backdrop_size(width: u32, height: u32) -> (u32, u32) {
@@ -66,43 +78,51 @@ impl Backdrop {
             return None;
         }
         let clean = |v: f32| if v > 0.0 { v.min(MAX_RADIANCE) } else { 0.0 };
-        // Every level's texels, four words each; the chain adds at most a third.
-        let mut texel_bits = Vec::with_capacity(rgba.len() / 3 * 16 + 32);
-        for p in rgba {
-            texel_bits.extend_from_slice(&[
+        let mut sizes = vec![(width, height)];
+        let (mut w, mut h) = (width, height);
+        while w > 1 || h > 1 {
+            (w, h) = ((w / 2).max(1), (h / 2).max(1));
+            sizes.push((w, h));
+        }
+        let texels: usize = sizes.iter().map(|&(w, h)| w as usize * h as usize).sum();
+        // Every level's texels, four words each, and the zero texel after them.
+        let mut texel_bits = vec![0u32; (texels + 1) * 4];
+        for (t, p) in texel_bits.chunks_exact_mut(4).zip(rgba) {
+            t[..3].copy_from_slice(&[
                 clean(p[0]).to_bits(),
                 clean(p[1]).to_bits(),
                 clean(p[2]).to_bits(),
-                0,
             ]);
         }
-        let mut sizes = vec![(width, height)];
-        let (mut w, mut h, mut first) = (width, height, 0usize);
-        while w > 1 || h > 1 {
-            let (next_w, next_h) = ((w / 2).max(1), (h / 2).max(1));
-            let next_first = texel_bits.len() / 4;
-            let texel = |x: u32, y: u32| first + (y * w + x) as usize;
-            for y in 0..next_h {
+        let mut first = 0;
+        for pair in sizes.windows(2) {
+            let [(w, h), (next_w, next_h)] = [pair[0], pair[1]];
+            let next_first = first + w as usize * h as usize;
+            let (done, rest) = texel_bits.split_at_mut(next_first * 4);
+            let source = &done[first * 4..];
+            let row = |y: u32| &source[(y * w) as usize * 4..][..w as usize * 4];
+            let next_row = next_w as usize * 4;
+            for (y, target) in rest[..next_row * next_h as usize]
+                .chunks_exact_mut(next_row)
+                .enumerate()
+            {
+                let y = y as u32;
                 // The rows and columns of each 2 × 2 block, the last repeated at an odd edge
                 // (a side of 1 halves to 1).
-                let (y0, y1) = ((2 * y).min(h - 1), (2 * y + 1).min(h - 1));
-                for x in 0..next_w {
-                    let (x0, x1) = ((2 * x).min(w - 1), (2 * x + 1).min(w - 1));
-                    let quad = [texel(x0, y0), texel(x1, y0), texel(x0, y1), texel(x1, y1)];
-                    let channel = |t: usize, c: usize| f32::from_bits(texel_bits[t * 4 + c]);
-                    let mut mean = [0u32; 4];
-                    for (c, m) in mean[..3].iter_mut().enumerate() {
-                        let top = channel(quad[0], c) + channel(quad[1], c);
-                        let bottom = channel(quad[2], c) + channel(quad[3], c);
-                        *m = ((top + bottom) * 0.25).to_bits();
+                let (top, bottom) = (row((2 * y).min(h - 1)), row((2 * y + 1).min(h - 1)));
+                for (x, out) in target.chunks_exact_mut(4).enumerate() {
+                    let x = x as u32;
+                    let (x0, x1) = ((2 * x).min(w - 1) as usize, (2 * x + 1).min(w - 1) as usize);
+                    for c in 0..3 {
+                        let channel = |r: &[u32], x: usize| f32::from_bits(r[x * 4 + c]);
+                        let upper = channel(top, x0) + channel(top, x1);
+                        let lower = channel(bottom, x0) + channel(bottom, x1);
+                        out[c] = ((upper + lower) * 0.25).to_bits();
                     }
-                    texel_bits.extend_from_slice(&mean);
                 }
             }
-            sizes.push((next_w, next_h));
-            (w, h, first) = (next_w, next_h, next_first);
+            first = next_first;
         }
-        texel_bits.extend_from_slice(&[0; 4]);
         Some(Self {
             levels: LevelTable::new(&sizes),
             texel_bits,

@@ -392,3 +392,28 @@ fn punctual_light_behind_a_pane_comes_through() {
         "{front} vs {opaque}"
     );
 }
+
+#[test]
+fn the_backdrop_memory_is_counted_at_its_size() {
+    assert_eq!(
+        backdrop_bytes(640, 480),
+        640 * 480 * BACKDROP_BYTES_PER_PIXEL
+    );
+    // A 4K frame's backdrop is scaled to 2048 wide.
+    assert_eq!(
+        backdrop_bytes(4096, 2160),
+        2048 * 1080 * BACKDROP_BYTES_PER_PIXEL
+    );
+    let scene = |shading, transmission| crate::scene::Scene {
+        shading,
+        materials: vec![crate::scene::Material {
+            transmission,
+            ..crate::scene::Material::default()
+        }],
+        ..crate::scene::Scene::default()
+    };
+    use crate::scene::Shading::{Lambert, Pbr};
+    assert!(scene(Pbr, 0.5).has_transmission());
+    assert!(!scene(Pbr, 0.0).has_transmission());
+    assert!(!scene(Lambert, 0.5).has_transmission());
+}
