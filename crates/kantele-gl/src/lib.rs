@@ -439,29 +439,18 @@ impl Backend for GlBackend {
             let framebuffer = self.target.as_ref().expect("checked above").framebuffer;
             self.draw_frame(&scene, &view, framebuffer, true, &mut FrameStats::default())?;
         }
-        let target = self.target.as_ref().expect("checked above");
-        let pixels = width as usize * height as usize;
-        let mut color = vec![0u8; pixels * 16];
-        let mut depth = vec![0u8; pixels * 4];
-        // SAFETY: the context is current on this thread; the framebuffer is ours; the buffers
-        // hold exactly width × height RGBA f32 / f32 values with PACK_ALIGNMENT 4 and no row
-        // length, which is what glReadPixels writes for these formats.
+        let framebuffer = self.target.as_ref().expect("checked above").framebuffer;
+        let color = self.read_color(framebuffer, width, height)?;
+        let mut depth = vec![0u8; width as usize * height as usize * 4];
+        // SAFETY: the context is current on this thread; the framebuffer is ours; the buffer
+        // holds exactly width × height f32 values with PACK_ALIGNMENT 4 and no row length,
+        // which is what glReadPixels writes for this format.
         unsafe {
             let gl = &self.gl;
             gl.bind_buffer(glow::PIXEL_PACK_BUFFER, None);
-            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(target.framebuffer));
-            gl.read_buffer(glow::COLOR_ATTACHMENT0);
+            gl.bind_framebuffer(glow::READ_FRAMEBUFFER, Some(framebuffer));
             gl.pixel_store_i32(glow::PACK_ALIGNMENT, 4);
             gl.pixel_store_i32(glow::PACK_ROW_LENGTH, 0);
-            gl.read_pixels(
-                0,
-                0,
-                width as i32,
-                height as i32,
-                glow::RGBA,
-                glow::FLOAT,
-                glow::PixelPackData::Slice(Some(&mut color)),
-            );
             gl.read_pixels(
                 0,
                 0,
@@ -478,17 +467,7 @@ impl Backend for GlBackend {
         Ok(FrameImage {
             width,
             height,
-            color: color
-                .chunks_exact(16)
-                .map(|p| {
-                    [
-                        float(&p[0..4]),
-                        float(&p[4..8]),
-                        float(&p[8..12]),
-                        float(&p[12..16]),
-                    ]
-                })
-                .collect(),
+            color,
             depth: depth.chunks_exact(4).map(float).collect(),
         })
     }

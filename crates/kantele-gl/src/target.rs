@@ -294,7 +294,7 @@ impl GlBackend {
     }
 
     /// The `width × height` RGBA float colour of `framebuffer`'s first attachment, GL's row 0
-    /// first (the image's top row under the y-flipped projection).
+    /// first (the image's top row under the y-flipped projection): a frame's or a backdrop's.
     pub(crate) fn read_color(
         &self,
         framebuffer: glow::Framebuffer,
@@ -323,7 +323,7 @@ impl GlBackend {
             );
             gl.bind_framebuffer(glow::READ_FRAMEBUFFER, None);
         }
-        self.check("reading the backdrop back")?;
+        self.check("reading colour back")?;
         let float = |b: &[u8]| f32::from_ne_bytes([b[0], b[1], b[2], b[3]]);
         Ok(color
             .chunks_exact(16)

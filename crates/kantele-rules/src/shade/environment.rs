@@ -18,7 +18,7 @@ use std::sync::{Arc, OnceLock};
 use glam::{Vec2, Vec3};
 use kantele_lanes::{F32x8, I32x8, Lanes, Mask8, Scalar, TexelGather};
 
-use super::levels::{lane_table, lookup16, LaneTable};
+use super::levels::{bilinear_rgb, lane_table, lookup16, LaneTable};
 
 #[path = "environment_prepare.rs"]
 mod prepare;
@@ -363,26 +363,7 @@ fn sample_level_lanes<L: Lanes>(
     // Word index of a row's left texel; its right texel follows four words on.
     let top = (first + y0 * stride + x0).shl::<2>();
     let bottom = (first + y1 * stride + x0).shl::<2>();
-    let right = lanes.splat_i32(4);
-    let [top_left, top_right, bottom_left, bottom_right] = [
-        top.gather_u32_quad(table),
-        (top + right).gather_u32_quad(table),
-        bottom.gather_u32_quad(table),
-        (bottom + right).gather_u32_quad(table),
-    ];
-    let mut out = [zero; 3];
-    for (c, o) in out.iter_mut().enumerate() {
-        let t = [
-            L::F32::from_bits(top_left[c]),
-            L::F32::from_bits(top_right[c]),
-            L::F32::from_bits(bottom_left[c]),
-            L::F32::from_bits(bottom_right[c]),
-        ];
-        let top = t[0] + (t[1] - t[0]) * fx;
-        let bottom = t[2] + (t[3] - t[2]) * fx;
-        *o = top + (bottom - top) * fy;
-    }
-    out
+    bilinear_rgb(lanes, table, top, bottom, fx, fy)
 }
 
 /// [`LEVEL_SIZES`] and [`LEVEL_OFFSETS`] as [`LaneTable`]s, the form the lane lookups read

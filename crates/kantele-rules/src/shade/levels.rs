@@ -1,7 +1,7 @@
 //! Where each level of a texture's mip chain lies: a [`LevelTable`] of offsets and sizes, and
 //! the same values as [`LaneTable`]s, the form the lane-wide sampler looks them up in.
 
-use kantele_lanes::{F32x8, I32x8, Lanes, Mask8};
+use kantele_lanes::{F32x8, I32x8, Lanes, Mask8, TexelGather};
 
 use crate::state::MAX_TEXTURE_SIZE;
 
@@ -86,4 +86,39 @@ pub(super) fn lookup16<L: Lanes>(table: &LaneTable, index: L::I32) -> L::I32 {
     let high = L::F32::from_bits(lanes.load_i32(&table[8..])).permute(index);
     let in_high = (index & lanes.splat_i32(8)).simd_eq(lanes.splat_i32(8));
     in_high.select_f32(high, low).to_bits()
+}
+
+/// The bilinear blend of RGB texels stored four words apart (RGB and a 0, as `f32` bits), per
+/// lane: `top` and `bottom` are the word indices of the left texels of the footprint's two rows,
+/// each row's right texel the next in memory; `fx`, `fy` the weights of the right and bottom
+/// texels. Each row's two texels are read together ([`TexelGather::gather_u32_quad`]).
+#[inline(always)]
+pub(super) fn bilinear_rgb<L: Lanes>(
+    lanes: L,
+    table: &[u32],
+    top: L::I32,
+    bottom: L::I32,
+    fx: L::F32,
+    fy: L::F32,
+) -> [L::F32; 3] {
+    let right = lanes.splat_i32(4);
+    let [top_left, top_right, bottom_left, bottom_right] = [
+        top.gather_u32_quad(table),
+        (top + right).gather_u32_quad(table),
+        bottom.gather_u32_quad(table),
+        (bottom + right).gather_u32_quad(table),
+    ];
+    let mut out = [lanes.splat_f32(0.0); 3];
+    for (c, o) in out.iter_mut().enumerate() {
+        let t = [
+            L::F32::from_bits(top_left[c]),
+            L::F32::from_bits(top_right[c]),
+            L::F32::from_bits(bottom_left[c]),
+            L::F32::from_bits(bottom_right[c]),
+        ];
+        let top = t[0] + (t[1] - t[0]) * fx;
+        let bottom = t[2] + (t[3] - t[2]) * fx;
+        *o = top + (bottom - top) * fy;
+    }
+    out
 }

@@ -18,10 +18,10 @@
 use std::sync::Arc;
 
 use glam::{Mat4, Vec2, Vec3};
-use kantele_lanes::{F32x8, I32x8, Lanes, Mask8, Scalar, TexelGather};
+use kantele_lanes::{F32x8, I32x8, Lanes, Mask8, Scalar};
 
 use super::environment::MAX_RADIANCE;
-use super::levels::{lookup16, LevelTable};
+use super::levels::{bilinear_rgb, lookup16, LevelTable};
 
 /// The longest side of a backdrop: frames larger than this are drawn into a backdrop scaled
 /// down to fit (memory stays at most 2048² × 16 bytes × 4/3).
@@ -214,27 +214,7 @@ impl Backdrop {
         let y1 = (y0 + one).min(h - one);
         let top = (first + y0 * w + x0).shl::<2>();
         let bottom = (first + y1 * w + x0).shl::<2>();
-        let right = lanes.splat_i32(4);
-        let table = &self.texel_bits;
-        let [top_left, top_right, bottom_left, bottom_right] = [
-            top.gather_u32_quad(table),
-            (top + right).gather_u32_quad(table),
-            bottom.gather_u32_quad(table),
-            (bottom + right).gather_u32_quad(table),
-        ];
-        let mut out = [zero; 3];
-        for (c, o) in out.iter_mut().enumerate() {
-            let t = [
-                L::F32::from_bits(top_left[c]),
-                L::F32::from_bits(top_right[c]),
-                L::F32::from_bits(bottom_left[c]),
-                L::F32::from_bits(bottom_right[c]),
-            ];
-            let top = t[0] + (t[1] - t[0]) * fx;
-            let bottom = t[2] + (t[3] - t[2]) * fx;
-            *o = top + (bottom - top) * fy;
-        }
-        out
+        bilinear_rgb(lanes, &self.texel_bits, top, bottom, fx, fy)
     }
 }
 
