@@ -229,7 +229,7 @@ impl GlBackend {
                 let gpu_mesh = &self.gpu.meshes[draw.mesh];
                 let material = scene.draw_material(draw.mesh, &unlit);
                 if setup.backdrop_pass
-                    && (material.has_transmission() || material.alpha_mode == AlphaMode::Blend)
+                    && (material.has_transmission() || scene.is_blended(draw_index))
                 {
                     continue;
                 }

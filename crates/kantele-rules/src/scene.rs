@@ -560,17 +560,11 @@ impl Scene {
     /// front by the eye-space depth of their world bounding-box centre (ties, and draws without
     /// a finite box, keep scene order). The reference-scene rule; both backends use it per frame.
     pub fn draw_order(&self, view: &Mat4) -> Vec<usize> {
-        let is_blend = |draw: &Draw| {
-            self.meshes
-                .get(draw.mesh)
-                .and_then(|m| self.materials.get(m.material))
-                .is_some_and(|m| m.alpha_mode == AlphaMode::Blend)
-        };
         let mut order: Vec<usize> = (0..self.draws.len())
-            .filter(|&i| !is_blend(&self.draws[i]))
+            .filter(|&i| !self.is_blended(i))
             .collect();
         let mut blended: Vec<(f32, usize)> = (0..self.draws.len())
-            .filter(|&i| is_blend(&self.draws[i]))
+            .filter(|&i| self.is_blended(i))
             .map(|i| {
                 let draw = &self.draws[i];
                 let depth = self
@@ -591,6 +585,16 @@ impl Scene {
         blended.sort_by(|a, b| a.0.total_cmp(&b.0));
         order.extend(blended.into_iter().map(|(_, i)| i));
         order
+    }
+
+    /// Whether draw `i` blends ([`AlphaMode::Blend`]; `false` for a draw or mesh that does not
+    /// exist): such draws come last, back to front, in [`Scene::draw_order`].
+    pub fn is_blended(&self, i: usize) -> bool {
+        self.draws
+            .get(i)
+            .and_then(|draw| self.meshes.get(draw.mesh))
+            .and_then(|m| self.materials.get(m.material))
+            .is_some_and(|m| m.alpha_mode == AlphaMode::Blend)
     }
 
     /// Whether colour frames of the scene draw a backdrop first: PBR shading with a

@@ -11,7 +11,7 @@ use crate::rop::{Framebuffer, TargetFormat};
 use kantele_rules::backend::{FrameView, Pass};
 use kantele_rules::error::RenderError;
 use kantele_rules::multisample::SampleCount;
-use kantele_rules::scene::{AlphaMode, Material, Scene};
+use kantele_rules::scene::{Material, Scene};
 use kantele_rules::shade::pbr::{PbrLighting, Tonemap};
 use kantele_rules::shade::transmission::{backdrop_size, Backdrop, TransmissionView};
 use kantele_rules::stats::FrameStats;
@@ -28,7 +28,8 @@ impl CpuBackend {
             return Err(layout_mismatch());
         };
         let mut lighting = PbrLighting::for_frame(scene, view);
-        let transmissive = transmissive_draws(scene);
+        let unlit = scene.unlit_materials();
+        let transmissive = transmissive_draws(scene, &unlit);
         if view.pass == Pass::Color && transmissive.iter().any(|&t| t) {
             let (width, height) = backdrop_size(view.width, view.height);
             let mut target = match self.backdrop_target.take() {
@@ -44,7 +45,14 @@ impl CpuBackend {
             };
             // Draw into the backdrop's target, then give the frame its own back.
             self.renderer.swap_target(&mut target);
-            let backdrop = draw_backdrop(&mut self.renderer, scene, meshes, view, &transmissive);
+            let backdrop = draw_backdrop(
+                &mut self.renderer,
+                scene,
+                &unlit,
+                meshes,
+                view,
+                &transmissive,
+            );
             self.renderer.swap_target(&mut target);
             self.backdrop_target = Some(target);
             lighting.transmission = Some(TransmissionView {
@@ -52,7 +60,6 @@ impl CpuBackend {
                 view_projection: view.projection * view.view,
             });
         }
-        let unlit = scene.unlit_materials();
         let shaders = pbr_shaders(scene, &unlit, view, &lighting);
         draw_scene(
             &mut self.renderer,
@@ -66,13 +73,12 @@ impl CpuBackend {
     }
 }
 
-/// Whether each draw of `scene` has a transmissive material.
-fn transmissive_draws(scene: &Scene) -> Vec<bool> {
-    let unlit = scene.unlit_materials();
+/// Whether each draw of `scene` has a transmissive material (`unlit`: its unlit materials).
+fn transmissive_draws(scene: &Scene, unlit: &[Material]) -> Vec<bool> {
     scene
         .draws
         .iter()
-        .map(|draw| scene.draw_material(draw.mesh, &unlit).has_transmission())
+        .map(|draw| scene.draw_material(draw.mesh, unlit).has_transmission())
         .collect()
 }
 
@@ -84,6 +90,7 @@ fn transmissive_draws(scene: &Scene) -> Vec<bool> {
 fn draw_backdrop(
     renderer: &mut Renderer,
     scene: &Scene,
+    unlit: &[Material],
     meshes: &[PreparedMesh<PbrVertex>],
     view: &FrameView,
     transmissive: &[bool],
@@ -95,16 +102,7 @@ fn draw_backdrop(
     let mut lighting = PbrLighting::for_frame(scene, view);
     lighting.exposure = 1.0;
     lighting.tonemap = Tonemap::None;
-    let unlit = scene.unlit_materials();
-    let shaders = pbr_shaders(scene, &unlit, view, &lighting);
-    let blended = |i: usize| {
-        let draw = &scene.draws[i];
-        scene
-            .meshes
-            .get(draw.mesh)
-            .and_then(|m| scene.materials.get(m.material))
-            .is_some_and(|m| m.alpha_mode == AlphaMode::Blend)
-    };
+    let shaders = pbr_shaders(scene, unlit, view, &lighting);
     draw_scene(
         renderer,
         scene,
@@ -112,7 +110,7 @@ fn draw_backdrop(
         view,
         &shaders,
         |s| s.render_state(),
-        |i| !transmissive[i] && !blended(i),
+        |i| !transmissive[i] && !scene.is_blended(i),
     )?;
     let color = renderer.framebuffer().try_read_color()?;
     Backdrop::new(width, height, &color).ok_or_else(|| {
