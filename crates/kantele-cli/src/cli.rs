@@ -74,7 +74,7 @@ pub struct SceneArgs {
     /// ("scans/*.glb").
     #[arg(value_name = "SCENE")]
     pub scenes: Vec<PathBuf>,
-    /// A built-in scene (cube, teapot, ground, pixel-edges, pbr-spheres, pbr-lights, pbr-glass); may be repeated. Built-ins come after the files.
+    /// A built-in scene (cube, teapot, ground, pixel-edges, pbr-spheres, pbr-lights, pbr-glass, pbr-sheen); may be repeated. Built-ins come after the files.
     #[arg(long = "builtin", value_name = "NAME")]
     pub builtins: Vec<String>,
     /// How the files are read, shaded and posed.

@@ -12,8 +12,8 @@
 //! `KHR_materials_specular`, the coat of `KHR_materials_clearcoat` (its factor, roughness and
 //! normal texture, bent in the same frame), the transmission and thickness of
 //! `KHR_materials_transmission` and `KHR_materials_volume` (where the frame has a backdrop:
-//! [`PbrLighting::transmission`]); then [`pbr::shade`] with the emission, exposure and the
-//! tone map.
+//! [`PbrLighting::transmission`]), the sheen colour and roughness of `KHR_materials_sheen`;
+//! then [`pbr::shade`] with the emission, exposure and the tone map.
 //!
 //! Each texture reads one of the mesh's two texture coordinate sets
 //! ([`TextureBinding::texcoord`](kantele_rules::scene::TextureBinding::texcoord)).
@@ -32,6 +32,7 @@ use kantele_rules::backend::Pass;
 use kantele_rules::camera::normal_matrix;
 use kantele_rules::scene::{AlphaMode, Material};
 use kantele_rules::shade::pbr::{self, normalize3, ClearcoatLayer, PbrLighting, Surface};
+use kantele_rules::shade::sheen::SheenLayer;
 use kantele_rules::shade::texture::{Sampler, Texture};
 use kantele_rules::shade::transmission::{TransmissionLayer, Volume};
 use kantele_rules::vertex::PbrVertex;
@@ -132,6 +133,10 @@ pub struct PbrTextures<'a> {
     pub transmission: BoundTexture<'a>,
     /// Linear: green = thickness (`KHR_materials_volume`).
     pub thickness: BoundTexture<'a>,
+    /// sRGB: the sheen's colour (`KHR_materials_sheen`).
+    pub sheen_color: BoundTexture<'a>,
+    /// Linear: alpha = sheen roughness.
+    pub sheen_roughness: BoundTexture<'a>,
 }
 
 impl<'a> PbrTextures<'a> {
@@ -150,20 +155,17 @@ impl<'a> PbrTextures<'a> {
             (CLEARCOAT_NORMAL, self.clearcoat_normal),
             (TRANSMISSION, self.transmission),
             (THICKNESS, self.thickness),
+            (SHEEN_COLOR, self.sheen_color),
+            (SHEEN_ROUGHNESS, self.sheen_roughness),
         ]
     }
 
     /// The textures a draw of `pass` reads, with the slot of [`Texels`] each fills: all of
-    /// them for colour (the clear coat's only with a coat, transmission and thickness only
-    /// when the draw transmits); the base colour (for its alpha, where the material tests it)
-    /// and the normal texture for normals; the base colour for ids, where alpha is tested.
-    fn reads(
-        &self,
-        pass: Pass,
-        alpha_tested: bool,
-        clearcoat: bool,
-        transmits: bool,
-    ) -> TextureReads<'a> {
+    /// them for colour (the clear coat's only with a coat, the sheen's only with a sheen,
+    /// transmission and thickness only when the draw transmits); the base colour (for its
+    /// alpha, where the material tests it) and the normal texture for normals; the base colour
+    /// for ids, where alpha is tested.
+    fn reads(&self, pass: Pass, alpha_tested: bool, layers: Layers) -> TextureReads<'a> {
         let mut reads = TextureReads {
             reads: [None; SLOTS],
             count: 0,
@@ -173,9 +175,10 @@ impl<'a> PbrTextures<'a> {
                 BASE_COLOR => pass == Pass::Color || alpha_tested,
                 NORMAL => pass != Pass::Ids,
                 CLEARCOAT | CLEARCOAT_ROUGHNESS | CLEARCOAT_NORMAL => {
-                    pass == Pass::Color && clearcoat
+                    pass == Pass::Color && layers.clearcoat
                 }
-                TRANSMISSION | THICKNESS => pass == Pass::Color && transmits,
+                TRANSMISSION | THICKNESS => pass == Pass::Color && layers.transmits,
+                SHEEN_COLOR | SHEEN_ROUGHNESS => pass == Pass::Color && layers.sheen,
                 _ => pass == Pass::Color,
             };
             if let (Some(bound), true) = (bound, wanted) {
@@ -200,7 +203,17 @@ const CLEARCOAT_ROUGHNESS: usize = 8;
 const CLEARCOAT_NORMAL: usize = 9;
 const TRANSMISSION: usize = 10;
 const THICKNESS: usize = 11;
-const SLOTS: usize = 12;
+const SHEEN_COLOR: usize = 12;
+const SHEEN_ROUGHNESS: usize = 13;
+const SLOTS: usize = 14;
+
+/// The layers a draw shades besides its base.
+#[derive(Clone, Copy)]
+struct Layers {
+    clearcoat: bool,
+    transmits: bool,
+    sheen: bool,
+}
 
 /// The texels of a fragment's textures, by slot (1 where a texture is not read).
 type Texels<L> = [[<L as Lanes>::F32; 4]; SLOTS];
@@ -267,12 +280,12 @@ impl<'a> PbrShader<'a> {
             )),
             _ => None,
         };
-        let reads = textures.reads(
-            pass,
-            alpha_tested,
-            material.has_clearcoat(),
-            volume.is_some(),
-        );
+        let layers = Layers {
+            clearcoat: material.has_clearcoat(),
+            transmits: volume.is_some(),
+            sheen: material.has_sheen(),
+        };
+        let reads = textures.reads(pass, alpha_tested, layers);
         let mut shader = Self {
             model,
             model_view_projection: view_projection * model,
@@ -570,6 +583,34 @@ impl PbrShader<'_> {
             } else {
                 None
             };
+            // KHR_materials_sheen.
+            let sheen = if m.has_sheen() {
+                let c = m.sheen_color;
+                let mut color = [
+                    lanes.splat_f32(c.x),
+                    lanes.splat_f32(c.y),
+                    lanes.splat_f32(c.z),
+                ];
+                if self.textures.sheen_color.is_some() {
+                    for (k, channel) in color.iter_mut().enumerate() {
+                        *channel = *channel * texels[SHEEN_COLOR][k];
+                    }
+                }
+                let mut roughness = lanes.splat_f32(m.sheen_roughness);
+                if self.textures.sheen_roughness.is_some() {
+                    roughness = roughness * texels[SHEEN_ROUGHNESS][3];
+                }
+                Some(SheenLayer {
+                    color: [
+                        clamp01(lanes, color[0]),
+                        clamp01(lanes, color[1]),
+                        clamp01(lanes, color[2]),
+                    ],
+                    roughness: clamp01(lanes, roughness),
+                })
+            } else {
+                None
+            };
             let surface = Surface {
                 base: [base[0], base[1], base[2]],
                 metallic: clamp01(lanes, metallic),
@@ -588,6 +629,7 @@ impl PbrShader<'_> {
                 ],
                 specular_weight: clamp01(lanes, specular_weight),
                 clearcoat,
+                sheen,
                 transmission,
             };
             pbr::shade(lanes, self.lighting, &surface, &emissive)

@@ -128,8 +128,8 @@ fn render<S: Shader<Vertex = PbrVertex>>(
     renderer.framebuffer().read_color()
 }
 
-/// Every instruction set shades a fully textured, normal-mapped, clear-coated, environment-lit
-/// quad to the same bits, and one fragment at a time (the scalar texture sampler) agrees within
+/// Every instruction set shades a fully textured, normal-mapped, clear-coated, sheened,
+/// environment-lit quad to the same bits, and one fragment at a time (the scalar texture sampler) agrees within
 /// the samplers' rounding.
 #[test]
 fn lanes_agree_across_instruction_sets_and_with_one_fragment_at_a_time() {
@@ -167,6 +167,8 @@ fn lanes_agree(transmissive: bool) {
         thickness: 0.6,
         attenuation_color: Vec3::new(0.8, 0.5, 0.3),
         attenuation_distance: 0.7,
+        sheen_color: Vec3::new(0.8, 0.6, 0.9),
+        sheen_roughness: 0.5,
         ..Material::default()
     };
     let textures = PbrTextures {
@@ -182,6 +184,8 @@ fn lanes_agree(transmissive: bool) {
         clearcoat_normal: bound(&bumps),
         transmission: bound(&mr),
         thickness: bound(&base),
+        sheen_color: bound(&occlusion),
+        sheen_roughness: bound(&base),
     };
     let mut lighting = lighting(true);
     if transmissive {

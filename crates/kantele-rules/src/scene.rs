@@ -228,6 +228,15 @@ pub struct Material {
     pub attenuation_color: Vec3,
     /// `attenuationDistance` in world units; infinite: no attenuation.
     pub attenuation_distance: f32,
+    /// `sheenColorFactor`: the colour of a layer of fibres over the material
+    /// (`KHR_materials_sheen`, linear RGB in [0, 1]; black without it: no sheen).
+    pub sheen_color: Vec3,
+    /// sRGB texture whose RGB multiplies `sheen_color`.
+    pub sheen_color_texture: Option<TextureBinding>,
+    /// `sheenRoughnessFactor`, perceptual.
+    pub sheen_roughness: f32,
+    /// Linear texture whose alpha channel multiplies `sheen_roughness`.
+    pub sheen_roughness_texture: Option<TextureBinding>,
 }
 
 impl Default for Material {
@@ -265,6 +274,10 @@ impl Default for Material {
             thickness_texture: None,
             attenuation_color: Vec3::ONE,
             attenuation_distance: f32::INFINITY,
+            sheen_color: Vec3::ZERO,
+            sheen_color_texture: None,
+            sheen_roughness: 0.0,
+            sheen_roughness_texture: None,
         }
     }
 }
@@ -272,8 +285,9 @@ impl Default for Material {
 impl Material {
     /// The material's textures that PBR shading reads besides the base colour and emissive
     /// ones: metallic-roughness, normal, occlusion, specular, specular colour, clear coat,
-    /// clear-coat roughness, clear-coat normal, transmission and thickness.
-    pub fn pbr_textures(&self) -> [Option<TextureBinding>; 10] {
+    /// clear-coat roughness, clear-coat normal, transmission, thickness, sheen colour and sheen
+    /// roughness.
+    pub fn pbr_textures(&self) -> [Option<TextureBinding>; 12] {
         [
             self.metallic_roughness_texture,
             self.normal_texture,
@@ -285,7 +299,15 @@ impl Material {
             self.clearcoat_normal_texture,
             self.transmission_texture,
             self.thickness_texture,
+            self.sheen_color_texture,
+            self.sheen_roughness_texture,
         ]
+    }
+
+    /// Whether the material has a sheen (a sheen colour above black; unlit materials have
+    /// none).
+    pub fn has_sheen(&self) -> bool {
+        self.sheen_color.max_element() > 0.0 && !self.unlit
     }
 
     /// Whether the material has a clear coat (`clearcoat > 0`).

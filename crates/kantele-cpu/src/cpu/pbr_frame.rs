@@ -154,6 +154,8 @@ fn pbr_shaders<'a>(
                 clearcoat_normal: bound(material.clearcoat_normal_texture),
                 transmission: bound(material.transmission_texture),
                 thickness: bound(material.thickness_texture),
+                sheen_color: bound(material.sheen_color_texture),
+                sheen_roughness: bound(material.sheen_roughness_texture),
             };
             PbrShader::new(
                 draw.model,

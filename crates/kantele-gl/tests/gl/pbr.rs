@@ -224,6 +224,7 @@ fn expected(lighting: &PbrLighting, params: &Params, n: Vec3, p: Vec3) -> Vec3 {
                 roughness: Scalar.splat_f32(roughness),
                 normal: splat3(plane_normal()),
             }),
+            sheen: None,
             transmission: None,
         };
         lane0(shade(Scalar, lighting, &surface, &splat3(params.emissive)))

@@ -270,6 +270,7 @@ fn expected(
         dielectric_f0: splat3(Vec3::splat(DIELECTRIC_F0)),
         specular_weight: Scalar.splat_f32(1.0),
         clearcoat: None,
+        sheen: None,
         transmission: Some(TransmissionLayer {
             factor: Scalar.splat_f32(factor),
             thickness: Scalar.splat_f32(thickness),

@@ -244,6 +244,20 @@ impl EnvironmentLight {
 /// cell's centre and the right cell's weight is 0 (every cell is finite).
 #[inline(always)]
 pub fn brdf_ab_lanes<L: Lanes>(lanes: L, n_dot_v: L::F32, roughness: L::F32) -> [L::F32; 2] {
+    pair_table_lanes(lanes, brdf_table_bits(), n_dot_v, roughness)
+}
+
+/// Two values read bilinearly at `(n_dot_v, roughness)` from `table`, a
+/// `BRDF_TABLE_SIZE²` table of pairs laid out as [`brdf_table_bits`] (cell `(x, y)`'s pair at
+/// words `2 (y size + x)`, then one cell of zeros), clamped to its cell centres: the lookup of
+/// [`brdf_ab_lanes`] and of the sheen's albedo table.
+#[inline(always)]
+pub(super) fn pair_table_lanes<L: Lanes>(
+    lanes: L,
+    table: &[u32],
+    n_dot_v: L::F32,
+    roughness: L::F32,
+) -> [L::F32; 2] {
     let zero = lanes.splat_f32(0.0);
     let (x, y) = (
         brdf_coordinate(lanes, n_dot_v),
@@ -255,7 +269,6 @@ pub fn brdf_ab_lanes<L: Lanes>(lanes: L, n_dot_v: L::F32, roughness: L::F32) -> 
     let last = lanes.splat_i32(BRDF_TABLE_SIZE as i32 - 1);
     let y1 = (y0 + lanes.splat_i32(1)).min(last);
     let size = lanes.splat_i32(BRDF_TABLE_SIZE as i32);
-    let table = brdf_table_bits();
     // Cell (x, y) holds A at 2 (y size + x) and B after it: [A, B, A, B] of a row's two cells.
     let top = (y0 * size + x0).shl::<1>().gather_u32_quad(table);
     let bottom = (y1 * size + x0).shl::<1>().gather_u32_quad(table);

@@ -4,6 +4,7 @@ pub mod environment;
 mod levels;
 pub mod pbr;
 pub mod sample_lanes;
+pub mod sheen;
 pub mod spec_gloss;
 pub mod texel;
 mod texel_lanes;

@@ -1,10 +1,11 @@
 //! glTF 2.0's physically based shading, written once for every backend: the metallic-roughness
 //! BRDF of the specification's Appendix B (GGX distribution, Smith height-correlated
 //! visibility, Schlick Fresnel, the metal / dielectric mix), with the dielectric reflectance of
-//! `KHR_materials_ior` and `KHR_materials_specular`, the coat of `KHR_materials_clearcoat`
-//! and the transmission of `KHR_materials_transmission` and `KHR_materials_volume`
-//! ([`super::transmission`]); the `KHR_lights_punctual` falloff, image-based light through an [`EnvironmentLight`],
-//! exposure and tone mapping.
+//! `KHR_materials_ior` and `KHR_materials_specular`, the coat of `KHR_materials_clearcoat`,
+//! the sheen of `KHR_materials_sheen` ([`super::sheen`]) and the transmission of
+//! `KHR_materials_transmission` and `KHR_materials_volume` ([`super::transmission`]); the
+//! `KHR_lights_punctual` falloff, image-based light through an [`EnvironmentLight`], exposure
+//! and tone mapping.
 //!
 //! The functions are generic over [`Lanes`]: the CPU backend runs them on eight pixels at once,
 //! and on one pixel through the same code (a scalar [`Lanes`] with the value in every lane), so
@@ -15,6 +16,7 @@ use glam::Vec3;
 use kantele_lanes::{F32x8, Lanes, Mask8};
 
 use super::environment::{brdf_ab_lanes, EnvironmentLight};
+use super::sheen::{charlie_d, charlie_v, SheenLayer, SheenTerms};
 use super::transmission::{attenuate, transmitted_light, TransmissionLayer, TransmissionView};
 use crate::scene::{LightKind, PunctualLight};
 
@@ -152,6 +154,8 @@ pub struct Surface<L: Lanes> {
     pub specular_weight: L::F32,
     /// The clear coat, where the material has one.
     pub clearcoat: Option<ClearcoatLayer<L>>,
+    /// The sheen, where the material has one.
+    pub sheen: Option<SheenLayer<L>>,
     /// The transmission, where the material has one and the frame a backdrop
     /// ([`PbrLighting::transmission`]).
     pub transmission: Option<TransmissionLayer<L>>,
@@ -391,11 +395,42 @@ pub fn light_arrival<L: Lanes>(
     (l, finite.select_f32(attenuation, lanes.splat_f32(0.0)))
 }
 
+/// What one light or the environment gives a surface point, by layer: the base, the clear
+/// coat's lobe (not yet weighted by the coat factor) and the sheen's lobe (0 without them).
+#[derive(Clone, Copy)]
+struct Layers<L: Lanes> {
+    base: [L::F32; 3],
+    coat: [L::F32; 3],
+    sheen: [L::F32; 3],
+}
+
+impl<L: Lanes> Layers<L> {
+    #[inline(always)]
+    fn zero(lanes: L) -> Self {
+        let zero = [lanes.splat_f32(0.0); 3];
+        Self {
+            base: zero,
+            coat: zero,
+            sheen: zero,
+        }
+    }
+
+    #[inline(always)]
+    fn add(&mut self, other: &Self) {
+        for k in 0..3 {
+            self.base[k] = self.base[k] + other.base[k];
+            self.coat[k] = self.coat[k] + other.coat[k];
+            self.sheen[k] = self.sheen[k] + other.sheen[k];
+        }
+    }
+}
+
 /// Outgoing radiance of one surface point towards `view` (unit, towards the eye) lit by one
-/// punctual light: `radiance × NdotL × ((1 − F) c_diff / π + F D V)` (Appendix B); and, with
-/// a clear coat, the coat's lobe `radiance × NdotL_coat × F_coat D V` (its roughness and
-/// normal; not yet weighted by the coat factor).
+/// punctual light: `radiance × NdotL × ((1 − F) c_diff / π + F D V)` (Appendix B); with a
+/// clear coat, the coat's lobe `radiance × NdotL_coat × F_coat D V` (its roughness and normal);
+/// with a sheen, its lobe `radiance × NdotL × sheenColor × D_charlie × V_charlie`.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn punctual<L: Lanes>(
     lanes: L,
     light: &FrameLight,
@@ -404,7 +439,8 @@ fn punctual<L: Lanes>(
     r: &Reflectance<L>,
     alpha: L::F32,
     path: &[L::F32; 3],
-) -> ([L::F32; 3], [L::F32; 3]) {
+    sheen: Option<&SheenTerms<L>>,
+) -> Layers<L> {
     let (l, attenuation) = light_arrival(lanes, light, &s.position);
     let h = normalize3(lanes, [view[0] + l[0], view[1] + l[1], view[2] + l[2]]);
     let n_dot_l = clamp01(lanes, dot3::<L>(&s.normal, &l));
@@ -445,7 +481,19 @@ fn punctual<L: Lanes>(
             coat[c] = lanes.splat_f32(color[c]) * lobe;
         }
     }
-    (out, coat)
+    let mut sheen_out = [lanes.splat_f32(0.0); 3];
+    if let (Some(layer), Some(terms)) = (&s.sheen, sheen) {
+        let d = charlie_d(lanes, terms.alpha, terms.exponent, n_dot_h);
+        let lobe = scale * d * charlie_v(lanes, terms, n_dot_l, n_dot_v);
+        for c in 0..3 {
+            sheen_out[c] = lanes.splat_f32(color[c]) * lobe * layer.color[c];
+        }
+    }
+    Layers {
+        base: out,
+        coat,
+        sheen: sheen_out,
+    }
 }
 
 /// The light of one punctual light that a transmissive surface point lets through towards
@@ -521,7 +569,9 @@ fn punctual_transmission<L: Lanes>(
 /// With transmission of weight `t` (a [`TransmissionLayer`] and a frame's
 /// [`TransmissionView`]), `t` of the diffuse light (image-based and punctual) is replaced by
 /// light from behind: the backdrop's ([`transmitted_light`]) × `c_diff × (1 − FssEss)`, and
-/// each punctual light's transmitted lobe.
+/// each punctual light's transmitted lobe. With a sheen ([`super::sheen`]) all of that but the
+/// emission is scaled by `1 − max(sheenColor) E(NdotV)` and the sheen's lobes added, under the
+/// coat.
 #[inline(always)]
 pub fn shade<L: Lanes>(
     lanes: L,
@@ -540,27 +590,43 @@ pub fn shade<L: Lanes>(
     let r = reflectance(lanes, s);
     let clamped = s.roughness.max(lanes.splat_f32(MIN_PUNCTUAL_ROUGHNESS));
     let alpha = clamped * clamped;
-    let mut color = [lanes.splat_f32(0.0); 3];
-    let mut coat_color = [lanes.splat_f32(0.0); 3];
+    let mut sum = Layers::zero(lanes);
     let zero = lanes.splat_f32(0.0);
     let path = match &s.transmission {
         Some(layer) => super::transmission::refraction_path(lanes, layer, &s.normal, &view),
         None => [zero; 3],
     };
+    let sheen = s
+        .sheen
+        .as_ref()
+        .map(|layer| layer.terms(lanes, clamp01(lanes, dot3::<L>(&s.normal, &view))));
     for light in &lighting.lights {
-        let (c, coat) = punctual(lanes, light, s, &view, &r, alpha, &path);
-        for k in 0..3 {
-            color[k] = color[k] + c[k];
-            coat_color[k] = coat_color[k] + coat[k];
-        }
+        sum.add(&punctual(
+            lanes,
+            light,
+            s,
+            &view,
+            &r,
+            alpha,
+            &path,
+            sheen.as_ref(),
+        ));
     }
     if let Some(environment) = &lighting.environment {
-        let (ibl, coat_ibl) = image_based(lanes, environment, s, &view, &r);
-        for k in 0..3 {
-            color[k] = color[k] + ibl[k];
-            coat_color[k] = coat_color[k] + coat_ibl[k];
-        }
+        sum.add(&image_based(
+            lanes,
+            environment,
+            s,
+            &view,
+            &r,
+            sheen.as_ref(),
+        ));
     }
+    let Layers {
+        base: mut color,
+        coat: coat_color,
+        sheen: sheen_color,
+    } = sum;
     if let (Some(layer), Some(through)) = (&s.transmission, &lighting.transmission) {
         // The backdrop replaces the part `factor` of the dielectric's diffuse light (the
         // image-based part was scaled down in `image_based`), with the same room left by the
@@ -582,6 +648,11 @@ pub fn shade<L: Lanes>(
             color[k] = color[k] + layer.factor * r.c_diff[k] * (one - fss_ess) * light[k];
         }
     }
+    if let Some(terms) = &sheen {
+        for k in 0..3 {
+            color[k] = color[k] * terms.base_scale + sheen_color[k];
+        }
+    }
     for k in 0..3 {
         color[k] = color[k] + emissive[k];
     }
@@ -595,8 +666,8 @@ pub fn shade<L: Lanes>(
     color
 }
 
-/// The image-based part of [`shade`]: the light under the coat, and the coat's lobe (not yet
-/// weighted by the coat factor; 0 without a coat).
+/// The image-based part of [`shade`]: the light under the coat, the coat's lobe (not yet
+/// weighted by the coat factor; 0 without a coat) and the sheen's (0 without a sheen).
 #[inline(always)]
 fn image_based<L: Lanes>(
     lanes: L,
@@ -604,22 +675,28 @@ fn image_based<L: Lanes>(
     s: &Surface<L>,
     view: &[L::F32; 3],
     r: &Reflectance<L>,
-) -> ([L::F32; 3], [L::F32; 3]) {
+    sheen: Option<&SheenTerms<L>>,
+) -> Layers<L> {
     let one = lanes.splat_f32(1.0);
     let zero = lanes.splat_f32(0.0);
     let coat = s.clearcoat.as_ref();
-    // The specular lookups of the base and of the coat, from one call site: each call site of
-    // the lookups is compiled into every kernel.
-    let coat_lobe = match coat {
-        Some(layer) => (layer.normal, layer.roughness),
-        None => (s.normal, s.roughness),
-    };
-    let lobes = [(s.normal, s.roughness), coat_lobe];
-    let count = if coat.is_some() { 2 } else { 1 };
-    let mut reads = [([zero; 3], zero, zero); 2];
-    for ((n, roughness), read) in lobes[..count].iter().zip(&mut reads) {
+    // The specular lookups of the base, the coat and the sheen, from one call site: each call
+    // site of the lookups is compiled into every kernel. The base and the coat also read the
+    // split-sum table.
+    let mut lobes = [(s.normal, s.roughness); 3];
+    let mut count = 1;
+    if let Some(layer) = coat {
+        lobes[count] = (layer.normal, layer.roughness);
+        count += 1;
+    }
+    let split_sums = count;
+    if let Some(layer) = &s.sheen {
+        lobes[count] = (s.normal, layer.roughness);
+        count += 1;
+    }
+    let mut reads = [([zero; 3], zero, zero); 3];
+    for (k, ((n, roughness), read)) in lobes[..count].iter().zip(&mut reads).enumerate() {
         let n_dot_v_raw = dot3::<L>(n, view);
-        let n_dot_v = clamp01(lanes, n_dot_v_raw);
         // R = 2 (N·V) N − V.
         let two_n_dot_v = n_dot_v_raw + n_dot_v_raw;
         let reflected = [
@@ -627,9 +704,11 @@ fn image_based<L: Lanes>(
             two_n_dot_v * n[1] - view[1],
             two_n_dot_v * n[2] - view[2],
         ];
-        let specular = environment.specular_lanes(lanes, &reflected, *roughness);
-        let [a, b] = environment.brdf_lanes(lanes, n_dot_v, *roughness);
-        *read = (specular, a, b);
+        read.0 = environment.specular_lanes(lanes, &reflected, *roughness);
+        if k < split_sums {
+            let n_dot_v = clamp01(lanes, n_dot_v_raw);
+            [read.1, read.2] = environment.brdf_lanes(lanes, n_dot_v, *roughness);
+        }
     }
     let irradiance = environment.irradiance_lanes(lanes, &s.normal);
     let intensity = lanes.splat_f32(environment.intensity);
@@ -653,7 +732,19 @@ fn image_based<L: Lanes>(
             coat_out[c] = specular[c] * fss_ess * weight;
         }
     }
-    (out, coat_out)
+    let mut sheen_out = [zero; 3];
+    if let (Some(layer), Some(terms)) = (&s.sheen, sheen) {
+        let (specular, _, _) = reads[split_sums];
+        let scale = terms.albedo * weight;
+        for c in 0..3 {
+            sheen_out[c] = specular[c] * layer.color[c] * scale;
+        }
+    }
+    Layers {
+        base: out,
+        coat: coat_out,
+        sheen: sheen_out,
+    }
 }
 
 /// Exposure (`× scale`) and the tone map, per lane.

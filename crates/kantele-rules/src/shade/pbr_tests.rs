@@ -39,6 +39,7 @@ fn surface(
         dielectric_f0: splat3(Vec3::splat(DIELECTRIC_F0)),
         specular_weight: Scalar.splat_f32(1.0),
         clearcoat: None,
+        sheen: None,
         transmission: None,
     }
 }

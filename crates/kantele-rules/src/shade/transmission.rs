@@ -366,6 +366,19 @@ fn clip_row<L: Lanes>(lanes: L, m: &Mat4, r: usize, p: &[L::F32; 3]) -> L::F32 {
 /// exponent. Built of plain lane operations, so every instruction set gives the same bits.
 #[inline(always)]
 pub fn exp2_nonpositive<L: Lanes>(lanes: L, x: L::F32) -> L::F32 {
+    exp2_up_to(lanes, x, 0.0)
+}
+
+/// `2^x` per lane for `x` in [−126, 127] (values outside are clamped to it; NaN gives
+/// 2^−126): [`exp2_nonpositive`]'s polynomial over the whole exponent range.
+#[inline(always)]
+pub fn exp2<L: Lanes>(lanes: L, x: L::F32) -> L::F32 {
+    exp2_up_to(lanes, x, 127.0)
+}
+
+/// `2^x` for `x` clamped to [−126, `highest`] (`highest` at most 127).
+#[inline(always)]
+fn exp2_up_to<L: Lanes>(lanes: L, x: L::F32, highest: f32) -> L::F32 {
     // Taylor coefficients of 2^f = e^(f ln 2): (ln 2)^k / k!.
     const C: [f32; 7] = [
         std::f32::consts::LN_2,
@@ -376,7 +389,7 @@ pub fn exp2_nonpositive<L: Lanes>(lanes: L, x: L::F32) -> L::F32 {
         0.000_154_035_3,
         0.000_015_252_73,
     ];
-    let x = x.max(lanes.splat_f32(-126.0)).min(lanes.splat_f32(0.0));
+    let x = x.max(lanes.splat_f32(-126.0)).min(lanes.splat_f32(highest));
     let n = x.floor();
     let f = x - n;
     let mut p = lanes.splat_f32(C[6]);

@@ -306,6 +306,7 @@ fn a_clear_pane_shows_the_backdrop_less_its_reflection() {
             dielectric_f0: splat3(Vec3::splat(DIELECTRIC_F0)),
             specular_weight: Scalar.splat_f32(1.0),
             clearcoat: None,
+            sheen: None,
             transmission: Some(TransmissionLayer {
                 factor: Scalar.splat_f32(transmission),
                 ..layer(0.0, v)
@@ -363,6 +364,7 @@ fn punctual_light_behind_a_pane_comes_through() {
             dielectric_f0: splat3(Vec3::splat(DIELECTRIC_F0)),
             specular_weight: Scalar.splat_f32(1.0),
             clearcoat: None,
+            sheen: None,
             transmission: transmission.map(|t| TransmissionLayer {
                 factor: Scalar.splat_f32(t),
                 ..layer(0.0, v)

@@ -42,6 +42,10 @@ pub const SCENES: &[(&str, &str)] = &[
         "pbr-glass",
         "PBR: clear and frosted glass panes, a clear and a tinted glass volume over a checker (transmission)",
     ),
+    (
+        "pbr-sheen",
+        "PBR: velvet spheres over sheen colour and roughness, on a woven cloth floor (sheen)",
+    ),
 ];
 
 /// Background of the built-in scenes: a dark grey-blue (linear).
@@ -57,6 +61,7 @@ pub fn build(name: &str) -> Option<LoadedScene> {
         "pbr-spheres" => pbr::spheres(),
         "pbr-lights" => pbr::lights(),
         "pbr-glass" => pbr::glass(),
+        "pbr-sheen" => pbr::sheen(),
         _ => return None,
     };
     Some(finish(name, scene, info))

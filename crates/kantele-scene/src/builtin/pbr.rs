@@ -1,6 +1,7 @@
 //! Built-in PBR scenes, the reference scenes of the metallic-roughness model: a grid of spheres
 //! over metallic × roughness in the studio environment, a normal-mapped floor under point
-//! and spot lights with ranges, and transmissive panes and volumes over a checker.
+//! and spot lights with ranges, transmissive panes and volumes over a checker, and sheened
+//! cloth.
 
 use std::f32::consts::PI;
 use std::sync::Arc;
@@ -404,6 +405,149 @@ pub fn glass() -> (Scene, SceneInfo) {
         environment: Some(EnvironmentLight::studio()),
         clear_color: crate::shading::PBR_BACKGROUND,
         resolution: (960, 640),
+        ..Scene::default()
+    };
+    let info = SceneInfo {
+        camera_from_file: true,
+        lights: scene.lights.iter().map(|_| "light".to_string()).collect(),
+        ..SceneInfo::default()
+    };
+    (scene, info)
+}
+
+/// A `size²` weave of `threads` threads per side, as a sheen's two textures: sRGB warp and weft
+/// colours (gold and rose), and linear roughness in alpha (0.25 on the threads, 1 in the gaps
+/// between them).
+fn weave(size: u32, threads: u32) -> [Texture; 2] {
+    let mut color = Vec::with_capacity((size * size * 4) as usize);
+    let mut roughness = Vec::with_capacity((size * size * 4) as usize);
+    let cell = (size / threads).max(1);
+    for i in 0..size * size {
+        let (x, y) = (i % size, i / size);
+        let (cx, cy) = (x / cell, y / cell);
+        let warp_on_top = (cx + cy).is_multiple_of(2);
+        let (fx, fy) = (x % cell, y % cell);
+        let gap = fx == 0 || fy == 0;
+        color.extend_from_slice(if warp_on_top {
+            &[240, 200, 110, 255]
+        } else {
+            &[230, 150, 170, 255]
+        });
+        roughness.extend_from_slice(&[0, 0, 0, if gap { 255 } else { 64 }]);
+    }
+    let texture = |rgba: &[u8], space| {
+        Texture::from_rgba8(size, size, rgba, space).expect("a generated weave is a valid texture")
+    };
+    [
+        texture(&color, ColorSpace::Srgb),
+        texture(&roughness, ColorSpace::Linear),
+    ]
+}
+
+/// `pbr-sheen`: cloth (`KHR_materials_sheen`) in the studio with a key light and a warm point
+/// light: four columns of spheres — black velvet with a white sheen, dark red with a pink
+/// one, navy with a gold one, and the navy base without a sheen — over sheen roughness 0.2,
+/// 0.5 and 0.8 (rows, top to bottom), on a floor of woven cloth whose sheen colour and
+/// roughness are textures.
+pub fn sheen() -> (Scene, SceneInfo) {
+    let cloth = |name: String, base: Vec3, sheen_color: Vec3, sheen_roughness: f32| Material {
+        name,
+        base_color_factor: base.extend(1.0),
+        metallic: 0.0,
+        roughness: 0.8,
+        sheen_color,
+        sheen_roughness,
+        ..Material::default()
+    };
+    let columns = [
+        ("black velvet", Vec3::splat(0.01), Vec3::ONE),
+        (
+            "red velvet",
+            Vec3::new(0.25, 0.01, 0.02),
+            Vec3::new(1.0, 0.6, 0.7),
+        ),
+        (
+            "navy and gold",
+            Vec3::new(0.02, 0.03, 0.12),
+            Vec3::new(1.0, 0.8, 0.3),
+        ),
+        ("navy", Vec3::new(0.02, 0.03, 0.12), Vec3::ZERO),
+    ];
+    let sampler = || TextureBinding {
+        texture: 0,
+        sampler: trilinear_repeat(),
+        texcoord: 0,
+    };
+    let mut materials = vec![Material {
+        name: "woven floor".into(),
+        base_color_factor: Vec4::new(0.08, 0.05, 0.06, 1.0),
+        metallic: 0.0,
+        roughness: 0.9,
+        sheen_color: Vec3::ONE,
+        sheen_color_texture: Some(sampler()),
+        sheen_roughness: 1.0,
+        sheen_roughness_texture: Some(TextureBinding {
+            texture: 1,
+            ..sampler()
+        }),
+        ..Material::default()
+    }];
+    let mut meshes = vec![floor(0, 8.0)];
+    let mut draws = vec![draw(
+        0,
+        Mat4::from_scale(Vec3::splat(7.0)),
+        "floor".into(),
+        0,
+    )];
+    for (row, sheen_roughness) in [0.2f32, 0.5, 0.8].into_iter().enumerate() {
+        for (column, (name, base, sheen_color)) in columns.iter().enumerate() {
+            materials.push(cloth(
+                format!("{name}, sheen roughness {sheen_roughness}"),
+                *base,
+                *sheen_color,
+                sheen_roughness,
+            ));
+            let index = materials.len() - 1;
+            meshes.push(sphere(32, 48, index));
+            let at = Vec3::new(
+                (column as f32 - 1.5) * 2.2,
+                1.0 + (2 - row) as f32 * 2.2,
+                0.0,
+            );
+            draws.push(draw(
+                index,
+                Mat4::from_translation(at),
+                format!("sphere r{row} c{column}"),
+                index,
+            ));
+        }
+    }
+    let scene = Scene {
+        meshes,
+        materials,
+        textures: weave(128, 16).map(Arc::new).to_vec(),
+        draws,
+        camera: perspective(Vec3::new(0.0, 4.0, 15.0), Vec3::new(0.0, 3.0, 0.0), 38.0),
+        shading: Shading::Pbr,
+        lights: vec![
+            PunctualLight {
+                kind: LightKind::Directional,
+                color: Vec3::splat(2.0),
+                position: Vec3::ZERO,
+                direction: Vec3::new(0.5, -0.5, -0.7).normalize(),
+                range: None,
+            },
+            PunctualLight {
+                kind: LightKind::Point,
+                color: Vec3::new(40.0, 30.0, 20.0),
+                position: Vec3::new(-4.0, 6.5, 4.0),
+                direction: Vec3::NEG_Z,
+                range: Some(20.0),
+            },
+        ],
+        environment: Some(EnvironmentLight::studio()),
+        clear_color: crate::shading::PBR_BACKGROUND,
+        resolution: (960, 720),
         ..Scene::default()
     };
     let info = SceneInfo {

@@ -118,6 +118,8 @@ pub(super) enum TextureSlot {
     ClearcoatNormal,
     Transmission,
     Thickness,
+    SheenColor,
+    SheenRoughness,
 }
 
 impl TextureSlot {
@@ -135,6 +137,8 @@ impl TextureSlot {
             TextureSlot::ClearcoatNormal => "clear-coat normal",
             TextureSlot::Transmission => "transmission",
             TextureSlot::Thickness => "thickness",
+            TextureSlot::SheenColor => "sheen colour",
+            TextureSlot::SheenRoughness => "sheen roughness",
         }
     }
 }
@@ -281,6 +285,8 @@ impl<'a> Loader<'a> {
             thickness: extensions.thickness,
             attenuation_color: extensions.attenuation_color,
             attenuation_distance: extensions.attenuation_distance,
+            sheen_color: extensions.sheen_color,
+            sheen_roughness: extensions.sheen_roughness,
             ..Material::default()
         };
         if let Some(converted) = spec_gloss {
@@ -339,6 +345,8 @@ impl<'a> Loader<'a> {
                 TextureSlot::ClearcoatNormal => out.clearcoat_normal_texture = binding,
                 TextureSlot::Transmission => out.transmission_texture = binding,
                 TextureSlot::Thickness => out.thickness_texture = binding,
+                TextureSlot::SheenColor => out.sheen_color_texture = binding,
+                TextureSlot::SheenRoughness => out.sheen_roughness_texture = binding,
             }
         }
         self.material_uv.push(maps);

@@ -1,7 +1,7 @@
 //! The material extensions read from a material's JSON: `KHR_materials_ior`,
-//! `KHR_materials_specular`, `KHR_materials_clearcoat`, `KHR_materials_transmission` and
-//! `KHR_materials_volume` — their factors, and their textures with the colour space and
-//! texture coordinates each reads.
+//! `KHR_materials_specular`, `KHR_materials_clearcoat`, `KHR_materials_transmission`,
+//! `KHR_materials_volume` and `KHR_materials_sheen` — their factors, and their textures with
+//! the colour space and texture coordinates each reads.
 
 use glam::Vec3;
 use kantele_rules::shade::texture::ColorSpace;
@@ -32,6 +32,10 @@ pub(super) struct MaterialExtensions<'a> {
     pub(super) attenuation_color: Vec3,
     /// `attenuationDistance` (infinite without it).
     pub(super) attenuation_distance: f32,
+    /// `sheenColorFactor` (black without `KHR_materials_sheen`).
+    pub(super) sheen_color: Vec3,
+    /// `sheenRoughnessFactor`.
+    pub(super) sheen_roughness: f32,
     /// The extensions' textures.
     pub(super) textures: Vec<(TextureSlot, gltf::texture::Texture<'a>, ColorSpace, UvMap)>,
 }
@@ -40,6 +44,18 @@ pub(super) struct MaterialExtensions<'a> {
 /// (the reflectance of the core model).
 fn f0_of_ior(ior: f64) -> f32 {
     (((ior - 1.0) / (ior + 1.0)).powi(2)) as f32
+}
+
+/// `value[key]` as an RGB colour of finite numbers, else `default`.
+fn color_of(value: Option<&Value>, key: &str, default: Vec3) -> Vec3 {
+    value
+        .and_then(|v| v.get(key))
+        .and_then(Value::as_array)
+        .and_then(|a| {
+            let c = |i: usize| a.get(i)?.as_f64().filter(|v| v.is_finite());
+            Some(Vec3::new(c(0)? as f32, c(1)? as f32, c(2)? as f32))
+        })
+        .unwrap_or(default)
 }
 
 /// `value[key]` as a finite number, else `default`.
@@ -83,15 +99,9 @@ impl<'a> Loader<'a> {
         let volume = material
             .extension_value("KHR_materials_volume")
             .filter(|_| transmission.is_some());
-        let attenuation_color = volume
-            .and_then(|v| v.get("attenuationColor"))
-            .and_then(Value::as_array)
-            .and_then(|a| {
-                let c = |i: usize| a.get(i)?.as_f64().filter(|v| v.is_finite());
-                Some(Vec3::new(c(0)? as f32, c(1)? as f32, c(2)? as f32))
-            })
-            .unwrap_or(Vec3::ONE)
-            .clamp(Vec3::ZERO, Vec3::ONE);
+        let attenuation_color =
+            color_of(volume, "attenuationColor", Vec3::ONE).clamp(Vec3::ZERO, Vec3::ONE);
+        let sheen = material.extension_value("KHR_materials_sheen");
         let attenuation_distance = number(volume, "attenuationDistance", f64::INFINITY);
         let mut out = MaterialExtensions {
             dielectric_f0: Vec3::splat(f0_of_ior(ior)) * color,
@@ -113,6 +123,9 @@ impl<'a> Loader<'a> {
             } else {
                 f32::INFINITY
             },
+            sheen_color: color_of(sheen, "sheenColorFactor", Vec3::ZERO)
+                .clamp(Vec3::ZERO, Vec3::ONE),
+            sheen_roughness: number(sheen, "sheenRoughnessFactor", 0.0).clamp(0.0, 1.0) as f32,
             textures: Vec::new(),
         };
         let references = [
@@ -156,6 +169,18 @@ impl<'a> Loader<'a> {
                 volume,
                 "thicknessTexture",
                 TextureSlot::Thickness,
+                ColorSpace::Linear,
+            ),
+            (
+                sheen,
+                "sheenColorTexture",
+                TextureSlot::SheenColor,
+                ColorSpace::Srgb,
+            ),
+            (
+                sheen,
+                "sheenRoughnessTexture",
+                TextureSlot::SheenRoughness,
                 ColorSpace::Linear,
             ),
         ];

@@ -41,6 +41,7 @@ pub(crate) const SUPPORTED_EXTENSIONS: &[&str] = &[
     "KHR_materials_clearcoat",
     "KHR_materials_transmission",
     "KHR_materials_volume",
+    "KHR_materials_sheen",
     "KHR_materials_pbrSpecularGlossiness",
     "EXT_mesh_gpu_instancing",
     "EXT_texture_webp",

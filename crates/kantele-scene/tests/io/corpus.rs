@@ -750,3 +750,37 @@ fn a_line_without_normals_is_base_colour_plus_emissive() {
         }
     }
 }
+
+/// `KHR_materials_sheen`: the colour and roughness factors (clamped to [0, 1]) and both
+/// textures, the colour's decoded as sRGB and the roughness's as linear; no warning.
+#[test]
+fn sheen_is_read_with_its_textures() {
+    let mut g = quad_scene(json!({}));
+    let image = g.image(four_colour_png());
+    let texture = g.texture(json!({ "source": image }));
+    g.json["materials"][0] = json!({
+        "pbrMetallicRoughness": {"metallicFactor": 0.0},
+        "extensions": {"KHR_materials_sheen": {
+            "sheenColorFactor": [0.9, 1.5, -0.2],
+            "sheenColorTexture": {"index": texture},
+            "sheenRoughnessFactor": 0.4,
+            "sheenRoughnessTexture": {"index": texture},
+        }}
+    });
+    g.json["extensionsUsed"] = json!(["KHR_materials_sheen"]);
+    let loaded = load(&write(&g, "sheen"));
+    let scene = &loaded.scene;
+    let m = &scene.materials[0];
+    assert_eq!(m.sheen_color, glam::Vec3::new(0.9, 1.0, 0.0));
+    assert_eq!(m.sheen_roughness, 0.4);
+    assert!(m.has_sheen());
+    let color = m.sheen_color_texture.expect("sheen colour texture");
+    let roughness = m.sheen_roughness_texture.expect("sheen roughness texture");
+    use kantele::shade::texture::ColorSpace;
+    assert_eq!(scene.textures[color.texture].color_space, ColorSpace::Srgb);
+    assert_eq!(
+        scene.textures[roughness.texture].color_space,
+        ColorSpace::Linear
+    );
+    assert!(loaded.info.warnings.is_empty(), "{:?}", loaded.info.warnings);
+}

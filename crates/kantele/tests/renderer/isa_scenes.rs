@@ -70,6 +70,7 @@ fn built_in_scenes_are_identical_at_every_level() {
         "pbr-spheres",
         "pbr-lights",
         "pbr-glass",
+        "pbr-sheen",
     ] {
         let scene = builtin_scene(name).expect("built-in scene").scene;
         assert_levels_agree(name, scene, SampleCount::X1, Pass::Color);
