@@ -777,10 +777,17 @@ fn sheen_is_read_with_its_textures() {
     let color = m.sheen_color_texture.expect("sheen colour texture");
     let roughness = m.sheen_roughness_texture.expect("sheen roughness texture");
     use kantele::shade::texture::ColorSpace;
-    assert_eq!(scene.textures[color.texture].color_space, ColorSpace::Srgb);
     assert_eq!(
-        scene.textures[roughness.texture].color_space,
+        scene.textures[color.texture].source_color_space(),
+        ColorSpace::Srgb
+    );
+    assert_eq!(
+        scene.textures[roughness.texture].source_color_space(),
         ColorSpace::Linear
     );
-    assert!(loaded.info.warnings.is_empty(), "{:?}", loaded.info.warnings);
+    assert!(
+        loaded.info.warnings.is_empty(),
+        "{:?}",
+        loaded.info.warnings
+    );
 }
