@@ -374,7 +374,8 @@ pub struct RenderArgs {
     #[command(flatten)]
     pub cpu: CpuArgs,
     /// Memory for one image's pixels while it is rendered and written (render target, readback
-    /// and file rows; about 56 bytes a pixel), e.g. 512M, 2G (default 1G). A bigger picture is
+    /// and file rows; about 56 bytes a pixel, 120 at --msaa 4, 200 at --msaa 8), e.g. 512M, 2G
+    /// (default 1G). A bigger picture is
     /// rendered in horizontal bands of whole 64-row tiles, each streamed into its files (PNG,
     /// PFM, .npy; not .exr); the picture is bit-identical to an unbanded one.
     #[arg(long, value_name = "BYTES", value_parser = parse_bytes)]

@@ -10,7 +10,8 @@ use std::time::Instant;
 use anyhow::{anyhow, bail, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use kantele::backend::{Backend, FrameImage, FrameView, Pass};
-use kantele::band::{plan_bands, TARGET_BYTES_PER_PIXEL};
+use kantele::band::{plan_bands, target_bytes_per_pixel, TARGET_BYTES_PER_PIXEL};
+use kantele::multisample::SampleCount;
 use kantele::scene::Scene;
 use kantele::shade::transmission::backdrop_bytes;
 use kantele::stats::FrameStats;
@@ -223,10 +224,14 @@ fn render_band(
     Ok(RenderedBand { frame, stats, ms })
 }
 
-/// Bytes a pixel of a band costs the CLI: the CPU backend's tiles (linear RGBA + depth,
-/// `f32`), the band read back (the same again) and the rows converted for the files (at most
-/// 16 bytes: normals as three floats plus their PNG bytes).
-pub const BAND_BYTES_PER_PIXEL: usize = 2 * TARGET_BYTES_PER_PIXEL + 16;
+/// Bytes a pixel of a band costs the CLI at `samples` samples per pixel: the CPU backend's
+/// tiles (linear RGBA + depth, `f32`, per sample, and a centre depth when multisampled), the
+/// band read back (resolved: linear RGBA + depth) and the rows converted for the files (at
+/// most 16 bytes: normals as three floats plus their PNG bytes). 56 at 1 sample, 120 at 4,
+/// 200 at 8.
+pub const fn band_bytes_per_pixel(samples: SampleCount) -> usize {
+    target_bytes_per_pixel(samples) + TARGET_BYTES_PER_PIXEL + 16
+}
 
 /// The default frame memory budget (`--frame-memory`): 1 GiB.
 pub const DEFAULT_FRAME_MEMORY: u64 = 1 << 30;
@@ -405,7 +410,8 @@ impl SceneJob<'_> {
             0
         };
         let budget = frame_memory(args).saturating_sub(backdrop);
-        let bands = plan_bands(width, height, BAND_BYTES_PER_PIXEL, budget);
+        let per_pixel = band_bytes_per_pixel(backend.samples());
+        let bands = plan_bands(width, height, per_pixel, budget);
         if bands.len() > 1 {
             backend
                 .set_render_region(Some(bands[0].clone()))

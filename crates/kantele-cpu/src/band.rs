@@ -8,9 +8,19 @@
 use std::ops::Range;
 
 use kantele_rules::fixed::{TILE_PIXELS, TILE_SIZE};
+use kantele_rules::multisample::SampleCount;
 
 /// Bytes the CPU backend's tiles take per pixel: linear RGBA and depth, `f32` each.
-pub const TARGET_BYTES_PER_PIXEL: usize = 5 * std::mem::size_of::<f32>();
+pub const TARGET_BYTES_PER_PIXEL: usize = target_bytes_per_pixel(SampleCount::X1);
+
+/// Bytes the CPU backend's `f32` tiles take per pixel at `samples` samples per pixel: linear
+/// RGBA and depth, `f32` each, per sample, and a centre depth when multisampled (what
+/// [`crate::rop::multisample_framebuffer_bytes`] counts for each pixel).
+pub const fn target_bytes_per_pixel(samples: SampleCount) -> usize {
+    let n = samples.count();
+    let centre = if samples.is_multisampled() { 1 } else { 0 };
+    (5 * n + centre) * std::mem::size_of::<f32>()
+}
 
 /// Bytes of one tile row (64 pixel rows) of a `width`-pixel picture when every pixel costs
 /// `bytes_per_pixel` (saturating). Tiles are whole, so the width is rounded up to 64.
@@ -67,5 +77,31 @@ mod tests {
         assert_eq!(bands.last().map(|b| b.end), Some(16384));
         assert!(bands.windows(2).all(|w| w[0].end == w[1].start));
         assert!(bands.iter().all(|b| b.len() * 16384 * 56 <= 1 << 30));
+    }
+
+    /// Bands planned at a sample count's bytes per pixel keep that count's tiles within the
+    /// budget (but for the one-tile-row minimum).
+    #[test]
+    fn multisampled_bands_keep_their_tiles_within_budget() {
+        use crate::rop::multisample_framebuffer_bytes;
+        for samples in [SampleCount::X1, SampleCount::X4, SampleCount::X8] {
+            let per_pixel = target_bytes_per_pixel(samples);
+            assert_eq!(
+                per_pixel * TILE_PIXELS,
+                multisample_framebuffer_bytes(TILE_SIZE, TILE_SIZE, samples)
+            );
+            for (width, height) in [(100, 700), (4096, 4096), (16384, 300)] {
+                for budget in [1 << 20, 64 << 20, 1 << 30] {
+                    for band in plan_bands(width, height, per_pixel, budget) {
+                        let bytes =
+                            multisample_framebuffer_bytes(width, band.len() as u32, samples);
+                        assert!(
+                            bytes <= budget || band.len() <= TILE_SIZE as usize,
+                            "{samples}: {width}x{height} band {band:?} takes {bytes} bytes of {budget}"
+                        );
+                    }
+                }
+            }
+        }
     }
 }

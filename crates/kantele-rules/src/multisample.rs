@@ -63,7 +63,7 @@ impl SampleCount {
 
     /// The count as a number (1, 4 or 8).
     #[inline]
-    pub fn count(self) -> usize {
+    pub const fn count(self) -> usize {
         match self {
             SampleCount::X1 => 1,
             SampleCount::X4 => 4,
@@ -73,8 +73,8 @@ impl SampleCount {
 
     /// Whether this is more than one sample per pixel.
     #[inline]
-    pub fn is_multisampled(self) -> bool {
-        self != SampleCount::X1
+    pub const fn is_multisampled(self) -> bool {
+        !matches!(self, SampleCount::X1)
     }
 
     /// The count for `n` samples per pixel, or an error naming the supported counts.
