@@ -596,10 +596,13 @@ pub fn shade<L: Lanes>(
         Some(layer) => super::transmission::refraction_path(lanes, layer, &s.normal, &view),
         None => [zero; 3],
     };
-    let sheen = s
-        .sheen
-        .as_ref()
-        .map(|layer| layer.terms(lanes, clamp01(lanes, dot3::<L>(&s.normal, &view))));
+    // A `match`, not `Option::map`: a closure's body may be compiled out of line, without the
+    // kernel's instruction set.
+    #[allow(clippy::manual_map)]
+    let sheen = match &s.sheen {
+        Some(layer) => Some(layer.terms(lanes, clamp01(lanes, dot3::<L>(&s.normal, &view)))),
+        None => None,
+    };
     for light in &lighting.lights {
         sum.add(&punctual(
             lanes,

@@ -49,6 +49,8 @@ pub struct SheenTerms<L: Lanes> {
     pub base_scale: L::F32,
     /// The coefficients of [`sheen_lambda`] at `alpha`.
     pub fit: [L::F32; 5],
+    /// `2 L(½)`, twice the fit's exponent at ½ ([`sheen_lambda`]).
+    pub twice_at_half: L::F32,
     /// `Λ(NdotV)`.
     pub lambda_view: L::F32,
 }
@@ -65,13 +67,16 @@ impl<L: Lanes> SheenLayer<L> {
         let albedo = sheen_albedo_lanes(lanes, n_dot_v, roughness);
         let brightest = self.color[0].max(self.color[1]).max(self.color[2]);
         let fit = lambda_fit(lanes, alpha);
+        let at_half = lambda_exponent(lanes, &fit, lanes.splat_f32(0.5));
+        let twice_at_half = at_half + at_half;
         SheenTerms {
             alpha,
             exponent: lanes.splat_f32(0.5) / alpha,
             albedo,
             base_scale: (lanes.splat_f32(1.0) - brightest * albedo).max(lanes.splat_f32(0.0)),
-            lambda_view: sheen_lambda(lanes, &fit, n_dot_v),
+            lambda_view: sheen_lambda(lanes, &fit, twice_at_half, n_dot_v),
             fit,
+            twice_at_half,
         }
     }
 }
@@ -86,14 +91,18 @@ const LAMBDA_FIT: [[f32; 2]; 5] = [
     [-4.32054, -4.85967],
 ];
 
-/// The coefficients `(a, b, c, d, e)` of [`LAMBDA_FIT`] at `alpha`, per lane.
+/// The coefficients `(a, b, c, d, e)` of [`LAMBDA_FIT`] at `alpha`, per lane. A loop, not
+/// `[T; N]::map`: LLVM may compile a closure's body out of line, without the kernel's
+/// instruction set, and then each lane operation in it is a call.
 #[inline(always)]
 fn lambda_fit<L: Lanes>(lanes: L, alpha: L::F32) -> [L::F32; 5] {
     let one_minus = lanes.splat_f32(1.0) - alpha;
     let t = one_minus * one_minus;
-    LAMBDA_FIT.map(|[at_one, at_zero]| {
-        lanes.splat_f32(at_one) + (lanes.splat_f32(at_zero) - lanes.splat_f32(at_one)) * t
-    })
+    let mut fit = [t; 5];
+    for (value, [at_one, at_zero]) in fit.iter_mut().zip(LAMBDA_FIT) {
+        *value = lanes.splat_f32(at_one) + (lanes.splat_f32(at_zero) - lanes.splat_f32(at_one)) * t;
+    }
+    fit
 }
 
 /// The exponent of the fit, `a / (1 + b x^c) + d x + e`, for `x` in [0, 1] (`x^c` as
@@ -108,16 +117,19 @@ fn lambda_exponent<L: Lanes>(lanes: L, fit: &[L::F32; 5], x: L::F32) -> L::F32 {
 }
 
 /// The sheen's `Λ(cos θ)` for `cos θ` in [0, 1]: `exp(L(cos θ))` below ½,
-/// `exp(2 L(½) − L(1 − cos θ))` from there, `L` the fit's exponent ([`lambda_exponent`]).
+/// `exp(2 L(½) − L(1 − cos θ))` from there, `L` the fit's exponent ([`lambda_exponent`]) and
+/// `twice_at_half = 2 L(½)`. One evaluation of `L`, at `cos θ` or `1 − cos θ`.
 #[inline(always)]
-pub fn sheen_lambda<L: Lanes>(lanes: L, fit: &[L::F32; 5], cos_theta: L::F32) -> L::F32 {
-    let half = lanes.splat_f32(0.5);
-    let near = lambda_exponent(lanes, fit, cos_theta);
-    let at_half = lambda_exponent(lanes, fit, half);
-    let far = lambda_exponent(lanes, fit, lanes.splat_f32(1.0) - cos_theta);
-    let exponent = cos_theta
-        .simd_lt(half)
-        .select_f32(near, at_half + at_half - far);
+pub fn sheen_lambda<L: Lanes>(
+    lanes: L,
+    fit: &[L::F32; 5],
+    twice_at_half: L::F32,
+    cos_theta: L::F32,
+) -> L::F32 {
+    let below_half = cos_theta.simd_lt(lanes.splat_f32(0.5));
+    let x = below_half.select_f32(cos_theta, lanes.splat_f32(1.0) - cos_theta);
+    let l = lambda_exponent(lanes, fit, x);
+    let exponent = below_half.select_f32(l, twice_at_half - l);
     exp2(lanes, exponent * lanes.splat_f32(std::f32::consts::LOG2_E))
 }
 
@@ -131,7 +143,7 @@ pub fn charlie_v<L: Lanes>(
     n_dot_v: L::F32,
 ) -> L::F32 {
     let one = lanes.splat_f32(1.0);
-    let lambda_light = sheen_lambda(lanes, &terms.fit, n_dot_l);
+    let lambda_light = sheen_lambda(lanes, &terms.fit, terms.twice_at_half, n_dot_l);
     let denominator =
         (one + terms.lambda_view + lambda_light) * lanes.splat_f32(4.0) * n_dot_v * n_dot_l;
     // 1 / 0 is infinite, and clamps to 1.
