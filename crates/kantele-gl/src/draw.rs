@@ -207,7 +207,10 @@ impl GlBackend {
                     &self.pbr_uniforms,
                     lighting,
                     self.gpu.environment.as_ref(),
-                    self.gpu.brdf,
+                    pbr::LookupTables {
+                        brdf: self.gpu.brdf,
+                        sheen_albedo: self.gpu.sheen_albedo,
+                    },
                     setup.backdrop,
                 );
             }
@@ -338,9 +341,9 @@ impl GlBackend {
     /// The PBR program's uniforms and textures of one draw: the model matrix and whether it
     /// mirrors, the material's metallic, roughness, normal scale and occlusion strength, its
     /// PBR textures on their units with the samplers of the mesh's material, the texture
-    /// coordinate set of every texture, whether the mesh has tangents, and — for a
-    /// transmissive material in a frame with a `backdrop` — its transmission, thickness and
-    /// the rules' [`Volume`] constants.
+    /// coordinate set of every texture, whether the mesh has tangents, its sheen (colour,
+    /// roughness, and whether it has one), and — for a transmissive material in a frame with a
+    /// `backdrop` — its transmission, thickness and the rules' [`Volume`] constants.
     ///
     /// # Safety
     /// `self.gl` must be current on this thread with the PBR program in use; `material` must be
@@ -358,21 +361,12 @@ impl GlBackend {
         let samplers = self.gpu.pbr_samplers[mesh.material];
         let mirrored = Mat3::from_mat4(draw.model).determinant() < 0.0;
         let set = |b: Option<TextureBinding>| b.map_or(0, |b| b.texcoord as i32);
-        let mut sets = [
-            set(material.base_color_texture),
-            set(material.emissive_texture),
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-        ];
-        for (k, binding) in material.pbr_textures().into_iter().enumerate() {
+        // One texture per entry of PBR_TEXTURES (a different count does not compile).
+        let textures: [Option<TextureBinding>; pbr::PBR_TEXTURES.len()] = material.pbr_textures();
+        let mut sets = [0i32; pbr::TEXTURE_SLOTS];
+        sets[0] = set(material.base_color_texture);
+        sets[1] = set(material.emissive_texture);
+        for (k, binding) in textures.into_iter().enumerate() {
             sets[2 + k] = set(binding);
         }
         let volume = backdrop.filter(|_| material.has_transmission()).map(|b| {
@@ -418,8 +412,10 @@ impl GlBackend {
                 gl.uniform_3_f32_slice(u.attenuation.as_ref(), &volume.attenuation.to_array());
                 gl.uniform_1_f32(u.lod_scale.as_ref(), volume.lod_scale);
             }
-            for (k, ((binding, sampler), [has, _])) in material
-                .pbr_textures()
+            gl.uniform_1_i32(u.sheen.as_ref(), material.has_sheen() as i32);
+            gl.uniform_3_f32_slice(u.sheen_color.as_ref(), &material.sheen_color.to_array());
+            gl.uniform_1_f32(u.sheen_roughness.as_ref(), material.sheen_roughness);
+            for (k, ((binding, sampler), [has, _])) in textures
                 .into_iter()
                 .zip(samplers)
                 .zip(&u.textures)

@@ -79,6 +79,13 @@
 //!   the frame's view-projection. Each transmissive draw's `Volume` (index of refraction,
 //!   scale, Beer coefficients, level-of-detail scale) is computed on the host by the rules.
 //!   Other draws and frames are drawn as before.
+//! - **Sheen** (`KHR_materials_sheen`) follows `kantele_rules::shade::sheen`: the Charlie lobe
+//!   per light, the image-based sheen and the scale of the base under it, with the lobe's
+//!   albedo table computed by the rules and uploaded at `load` (for a scene with a sheen) as a
+//!   `GL_R32F` texture, read as the split-sum table is. With the sheen's two textures the PBR
+//!   fragment shader reads 18 samplers, more than OpenGL 3.3 guarantees (16):
+//!   [`GlBackend::new`] fails with one line where `GL_MAX_TEXTURE_IMAGE_UNITS` is smaller
+//!   (llvmpipe and NVIDIA offer 32).
 //! - **Passes.** [`Pass::Normals`] writes the world normal after two-sided flipping, alpha 1;
 //!   [`Pass::Ids`] writes `(node_index + 1, gl_PrimitiveID + 1, draw index + 1, 1)`. Both clear to
 //!   0 and never blend; MASK discards as in the colour pass and BLEND geometry is drawn without
@@ -193,7 +200,8 @@ impl GlBackend {
     /// current without a surface (`EGL_KHR_surfaceless_context`).
     ///
     /// Fails with [`RenderError::Backend`] (never panics) when EGL, a display or a context is not
-    /// available; the message lists every attempt.
+    /// available (the message lists every attempt), or when the context's fragment stage has
+    /// fewer texture units than the PBR program reads (18, `GL_MAX_TEXTURE_IMAGE_UNITS`).
     pub fn new() -> Result<Self, RenderError> {
         // EGL wrappers unwrap a few driver answers (an error code EGL does not define); a broken
         // driver must still only make `new` fail, so a panic in there is caught and reported.
@@ -220,7 +228,10 @@ impl GlBackend {
         let program = unsafe { build_program(&gl, shaders::VERTEX, shaders::FRAGMENT) }
             .map_err(backend_error)?;
         // SAFETY: `gl` is current on this thread.
-        let pbr_program = unsafe { build_program(&gl, pbr::VERTEX, &pbr::fragment_source()) }
+        let texture_units = unsafe { gl.get_parameter_i32(glow::MAX_TEXTURE_IMAGE_UNITS) };
+        let pbr_program = pbr::check_texture_units(texture_units)
+            // SAFETY: `gl` is current on this thread.
+            .and_then(|()| unsafe { build_program(&gl, pbr::VERTEX, &pbr::fragment_source()) })
             .map_err(|e| backend_error(format!("PBR program: {e}")))?;
         // SAFETY: `gl` is current; the programs are ours and linked.
         let (uniforms, pbr_uniforms) =

@@ -18,6 +18,14 @@
 //! come from the host; the backdrop is read with `textureLod` on the rules' own mip chain
 //! ([`crate::resources::GpuBackdrop`]), trilinear as `Backdrop::sample_lanes`. A draw without
 //! transmission (`u_transmissive` false) takes none of these branches.
+//!
+//! Sheen (`kantele_rules::shade::sheen`) likewise: the Charlie distribution and visibility
+//! with the rules' fit of `Λ` (GLSL's `log2` and `exp2` in place of the rules' lane
+//! polynomials, with the same clamps), the lobe's albedo read from the rules' own table (a
+//! `GL_R32F` texture, by `texelFetch` and the split-sum table's bilinear arithmetic), the base
+//! scaled by `1 − max(sheenColor) E(NdotV)` and the image-based sheen read along the reflected
+//! view at the sheen's roughness. A draw without a sheen (`u_sheen` false) takes none of these
+//! branches.
 
 use glam::{Mat4, Vec3};
 use glow::HasContext;
@@ -28,6 +36,7 @@ use kantele_rules::shade::pbr::{
     FrameLight, PbrLighting, Tonemap, DIELECTRIC_F0, MAX_LIGHTS, MIN_PUNCTUAL_ROUGHNESS,
     PBR_NEUTRAL_DESATURATION, PBR_NEUTRAL_START_COMPRESSION,
 };
+use kantele_rules::shade::sheen::LAMBDA_FIT;
 
 use crate::program::{uniforms, Uniforms};
 use crate::resources::{GpuBackdrop, GpuEnvironment};
@@ -35,7 +44,7 @@ use crate::resources::{GpuBackdrop, GpuEnvironment};
 /// The program's material textures besides the base colour and emissive ones, in the order of
 /// [`Material::pbr_textures`](kantele_rules::scene::Material::pbr_textures): the names of
 /// their `u_has_*` flag and sampler uniforms. Texture `k` is on unit [`FIRST_PBR_UNIT`] + `k`.
-pub(crate) const PBR_TEXTURES: [(&str, &str); 10] = [
+pub(crate) const PBR_TEXTURES: [(&str, &str); 12] = [
     (
         "u_has_metallic_roughness_texture",
         "u_metallic_roughness_texture",
@@ -55,16 +64,39 @@ pub(crate) const PBR_TEXTURES: [(&str, &str); 10] = [
     ),
     ("u_has_transmission_texture", "u_transmission_texture"),
     ("u_has_thickness_texture", "u_thickness_texture"),
+    ("u_has_sheen_color_texture", "u_sheen_color_texture"),
+    ("u_has_sheen_roughness_texture", "u_sheen_roughness_texture"),
 ];
 /// Texture unit of the first of [`PBR_TEXTURES`] (0 and 1 are the base colour and emissive).
 pub(crate) const FIRST_PBR_UNIT: u32 = 2;
+/// The material textures: the base colour, the emissive and [`PBR_TEXTURES`] (the length of
+/// `u_texcoord_set`).
+pub(crate) const TEXTURE_SLOTS: usize = 2 + PBR_TEXTURES.len();
 /// Texture unit of the environment's level atlas.
 pub(crate) const UNIT_ENVIRONMENT: u32 = FIRST_PBR_UNIT + PBR_TEXTURES.len() as u32;
 /// Texture unit of the split-sum table.
 pub(crate) const UNIT_BRDF: u32 = UNIT_ENVIRONMENT + 1;
-/// Texture unit of the frame's backdrop (transmission). With it the fragment shader reads 15
-/// samplers, within OpenGL 3.3's guaranteed 16.
+/// Texture unit of the frame's backdrop (transmission).
 pub(crate) const UNIT_BACKDROP: u32 = UNIT_BRDF + 1;
+/// Texture unit of the sheen's albedo table.
+pub(crate) const UNIT_SHEEN_ALBEDO: u32 = UNIT_BACKDROP + 1;
+/// The samplers the fragment shader reads, one per unit from 0 to [`UNIT_SHEEN_ALBEDO`]: 18,
+/// more than the 16 OpenGL 3.3 guarantees (`GL_MAX_TEXTURE_IMAGE_UNITS`; llvmpipe and NVIDIA
+/// offer 32). [`check_texture_units`] refuses a context with fewer.
+pub(crate) const FRAGMENT_SAMPLERS: u32 = UNIT_SHEEN_ALBEDO + 1;
+
+/// An error naming the shortfall when a context's fragment stage has fewer texture units
+/// (`available`, its `GL_MAX_TEXTURE_IMAGE_UNITS`) than the PBR program's
+/// [`FRAGMENT_SAMPLERS`].
+pub(crate) fn check_texture_units(available: i32) -> Result<(), String> {
+    if i64::from(available) < i64::from(FRAGMENT_SAMPLERS) {
+        return Err(format!(
+            "the PBR fragment shader reads {FRAGMENT_SAMPLERS} textures, the driver offers \
+             {available} fragment texture units (GL_MAX_TEXTURE_IMAGE_UNITS)"
+        ));
+    }
+    Ok(())
+}
 
 /// The vertex shader: the Lambert program's, plus the world position, the second texture
 /// coordinate set and the world tangent (PbrShader's vertex stage) for the fragment shader.
@@ -114,8 +146,9 @@ in vec4 v_tangent;
 
 // The texture coordinate set (0 or 1) each texture reads, in the CPU shader's slot order:
 // base colour, emissive, metallic-roughness, normal, occlusion, specular, specular colour,
-// clear coat, clear-coat roughness, clear-coat normal, transmission, thickness.
-uniform int u_texcoord_set[12];
+// clear coat, clear-coat roughness, clear-coat normal, transmission, thickness, sheen colour,
+// sheen roughness.
+uniform int u_texcoord_set[TEXTURE_SLOTS];
 // The set whose derivatives orient the tangent frame without mesh tangents.
 uniform int u_frame_set;
 // The mesh has tangents (else the derivative frame).
@@ -183,6 +216,14 @@ uniform float u_lod_scale;
 uniform sampler2D u_backdrop;
 uniform float u_backdrop_last_level;
 uniform mat4 u_backdrop_view_projection;
+// KHR_materials_sheen (u_sheen false: no sheen).
+uniform bool u_sheen;
+uniform vec3 u_sheen_color;
+uniform bool u_has_sheen_color_texture;
+uniform sampler2D u_sheen_color_texture;
+uniform float u_sheen_roughness;
+uniform bool u_has_sheen_roughness_texture;
+uniform sampler2D u_sheen_roughness_texture;
 
 // PbrLighting: the eye, the punctual lights (FrameLight, as u_punctual_*: u_light_color is
 // the Lambert program's), exposure scale and tone map.
@@ -207,6 +248,7 @@ uniform sampler2D u_environment;      // the levels, stacked (RGB32F, texelFetch
 uniform int u_level_row[LEVELS];      // first atlas row of each level
 uniform int u_level_size[LEVELS];     // each level's size without its border
 uniform sampler2D u_brdf;             // split-sum (A, B), RG32F, texelFetch only
+uniform sampler2D u_sheen_albedo;     // sheen::sheen_table, R32F, texelFetch only
 
 layout(location = 0) out vec4 o_color;
 
@@ -275,7 +317,52 @@ struct Surface {
     bool transmission;
     float transmission_factor;
     float thickness;
+    bool sheen;
+    vec3 sheen_color;
+    float sheen_roughness;
 };
+
+// sheen::SheenTerms: what the sheen needs once per point.
+struct SheenTerms {
+    float alpha;
+    float exponent;
+    float albedo;
+    float base_scale;
+    float fit[5];
+    float lambda_view;
+};
+
+// sheen::lambda_exponent: the fit's exponent a / (1 + b x^c) + d x + e for x in [0, 1]
+// (x^c = 2^(c log2 x), x no smaller than the least normal float).
+float lambda_exponent(float fit[5], float x) {
+    x = max(x, FLT_MIN_NORMAL);
+    float power = exp2(clamp(fit[2] * log2(x), -126.0, 0.0));
+    return fit[0] / (1.0 + fit[1] * power) + fit[3] * x + fit[4];
+}
+
+// sheen::sheen_lambda: exp(L(cos)) below 1/2, exp(2 L(1/2) - L(1 - cos)) from there.
+float sheen_lambda(float fit[5], float cos_theta) {
+    float below = lambda_exponent(fit, cos_theta);
+    float at_half = lambda_exponent(fit, 0.5);
+    float above = lambda_exponent(fit, 1.0 - cos_theta);
+    float exponent = cos_theta < 0.5 ? below : at_half + at_half - above;
+    return exp2(clamp(exponent * LOG2_E, -126.0, 127.0));
+}
+
+// sheen::charlie_v: 1 / ((1 + Lambda(NdotV) + Lambda(NdotL)) 4 NdotV NdotL), at most 1.
+float charlie_v(SheenTerms t, float n_dot_l, float n_dot_v) {
+    float lambda_light = sheen_lambda(t.fit, n_dot_l);
+    float denominator = (1.0 + t.lambda_view + lambda_light) * 4.0 * n_dot_v * n_dot_l;
+    // 1 / 0 is infinite, and clamps to 1.
+    return denominator > 0.0 ? min(1.0 / denominator, 1.0) : 1.0;
+}
+
+// sheen::charlie_d: (2 + 1/alpha) (1 - NdotH^2)^exponent / (2 pi).
+float charlie_d(float alpha, float exponent, float n_dot_h) {
+    float sin2 = max(1.0 - n_dot_h * n_dot_h, FLT_MIN_NORMAL);
+    float power = exp2(clamp(exponent * log2(sin2), -126.0, 0.0));
+    return (2.0 + 1.0 / alpha) * power * HALF_INV_PI;
+}
 
 // pbr::light_arrival: the unit vector towards light i and the attenuation.
 void light_arrival(int i, vec3 position, out vec3 l, out float attenuation) {
@@ -342,9 +429,13 @@ vec3 punctual_transmission(int i, Surface s, vec3 view, float alpha, vec3 path) 
     return attenuate(through, path);
 }
 
-// pbr::punctual: light i on the surface, and on its coat (into `coat`); `path` is the
-// refracted path through a transmissive surface's volume.
-vec3 punctual(int i, Surface s, vec3 view, float alpha, vec3 path, out vec3 coat) {
+// pbr::punctual: light i on the surface, on its coat (into `coat`) and on its sheen (into
+// `sheen_out`, with the point's terms `sheen`); `path` is the refracted path through a
+// transmissive surface's volume.
+vec3 punctual(
+    int i, Surface s, vec3 view, float alpha, vec3 path, SheenTerms sheen, out vec3 coat,
+    out vec3 sheen_out
+) {
     vec3 l;
     float attenuation;
     light_arrival(i, s.position, l, attenuation);
@@ -377,6 +468,12 @@ vec3 punctual(int i, Surface s, vec3 view, float alpha, vec3 path, out vec3 coat
         float c_dv = ggx_d_times_v(clamped * clamped, c_n_dot_l, c_n_dot_v, c_n_dot_h);
         float lobe = attenuation * c_n_dot_l * coat_fresnel(v_dot_h) * c_dv;
         coat = u_punctual_color[i] * lobe;
+    }
+    sheen_out = vec3(0.0);
+    if (s.sheen) {
+        float d = charlie_d(sheen.alpha, sheen.exponent, n_dot_h);
+        float lobe = scale * d * charlie_v(sheen, n_dot_l, n_dot_v);
+        sheen_out = u_punctual_color[i] * lobe * s.sheen_color;
     }
     if (s.transmission) {
         return u_punctual_color[i] * scale * brdf + through;
@@ -476,8 +573,9 @@ float brdf_coordinate(float v) {
     return clamp(v * n - 0.5, 0.0, n - 1.0);
 }
 
-// environment::brdf_ab: (A, B) read bilinearly from the table (clamped to its cell centres).
-vec2 brdf_ab(float n_dot_v, float roughness) {
+// environment::pair_table_lanes: two values read bilinearly from `table`, BRDF_TABLE_SIZE²
+// cells (x: NdotV, y: roughness), clamped to its cell centres.
+vec2 pair_table(sampler2D table, float n_dot_v, float roughness) {
     float x = brdf_coordinate(n_dot_v);
     float y = brdf_coordinate(roughness);
     float x0f = floor(x);
@@ -488,13 +586,56 @@ vec2 brdf_ab(float n_dot_v, float roughness) {
     int y0 = int(y0f);
     int x1 = min(x0 + 1, BRDF_TABLE_SIZE - 1);
     int y1 = min(y0 + 1, BRDF_TABLE_SIZE - 1);
-    vec2 t00 = texelFetch(u_brdf, ivec2(x0, y0), 0).rg;
-    vec2 t10 = texelFetch(u_brdf, ivec2(x1, y0), 0).rg;
-    vec2 t01 = texelFetch(u_brdf, ivec2(x0, y1), 0).rg;
-    vec2 t11 = texelFetch(u_brdf, ivec2(x1, y1), 0).rg;
+    vec2 t00 = texelFetch(table, ivec2(x0, y0), 0).rg;
+    vec2 t10 = texelFetch(table, ivec2(x1, y0), 0).rg;
+    vec2 t01 = texelFetch(table, ivec2(x0, y1), 0).rg;
+    vec2 t11 = texelFetch(table, ivec2(x1, y1), 0).rg;
     vec2 top = t00 + (t10 - t00) * fx;
     vec2 bottom = t01 + (t11 - t01) * fx;
     return top + (bottom - top) * fy;
+}
+
+// environment::brdf_ab: (A, B) read bilinearly from the split-sum table.
+vec2 brdf_ab(float n_dot_v, float roughness) {
+    return pair_table(u_brdf, n_dot_v, roughness);
+}
+
+// sheen::sheen_albedo_lanes: E(NdotV, roughness) read bilinearly from the sheen's table.
+float sheen_albedo(float n_dot_v, float roughness) {
+    return pair_table(u_sheen_albedo, n_dot_v, roughness).x;
+}
+
+// sheen::SheenLayer::terms at n_dot_v (clamped to [0, 1]).
+SheenTerms sheen_terms(Surface s, float n_dot_v) {
+    float roughness = min(max(s.sheen_roughness, MIN_PUNCTUAL_ROUGHNESS), 1.0);
+    SheenTerms t;
+    t.alpha = roughness * roughness;
+    t.albedo = sheen_albedo(n_dot_v, roughness);
+    float brightest = max(max(s.sheen_color.r, s.sheen_color.g), s.sheen_color.b);
+    // sheen::lambda_fit: each coefficient mixed by (1 - alpha)^2.
+    float one_minus = 1.0 - t.alpha;
+    float mixing = one_minus * one_minus;
+    for (int k = 0; k < 5; k++) {
+        t.fit[k] = LAMBDA_AT_ONE[k] + (LAMBDA_AT_ZERO[k] - LAMBDA_AT_ONE[k]) * mixing;
+    }
+    t.exponent = 0.5 / t.alpha;
+    t.base_scale = max(1.0 - brightest * t.albedo, 0.0);
+    t.lambda_view = sheen_lambda(t.fit, n_dot_v);
+    return t;
+}
+
+// Terms of a point without a sheen (never read).
+SheenTerms no_sheen() {
+    SheenTerms t;
+    t.alpha = 1.0;
+    t.exponent = 0.5;
+    t.albedo = 0.0;
+    t.base_scale = 1.0;
+    for (int k = 0; k < 5; k++) {
+        t.fit[k] = 0.0;
+    }
+    t.lambda_view = 0.0;
+    return t;
 }
 
 // pbr::image_based, one lobe: the pre-filtered radiance along the reflection about n and the
@@ -509,8 +650,9 @@ void environment_lobe(vec3 n, vec3 view, float roughness, out vec3 radiance, out
     ab = brdf_ab(n_dot_v, roughness);
 }
 
-// pbr::image_based: the light under the coat, and the coat's (into `coat`).
-vec3 image_based(Surface s, vec3 view, out vec3 coat) {
+// pbr::image_based: the light under the coat, the coat's (into `coat`) and the sheen's (into
+// `sheen_out`, with the point's terms `sheen`).
+vec3 image_based(Surface s, vec3 view, SheenTerms sheen, out vec3 coat, out vec3 sheen_out) {
     vec3 specular_;
     vec2 ab;
     environment_lobe(s.n, view, s.roughness, specular_, ab);
@@ -528,6 +670,15 @@ vec3 image_based(Surface s, vec3 view, out vec3 coat) {
         environment_lobe(s.coat_n, view, s.coat_roughness, coat_specular, coat_ab);
         float coat_fss_ess = DIELECTRIC_F0 * coat_ab.x + coat_ab.y;
         coat = coat_specular * coat_fss_ess * weight;
+    }
+    sheen_out = vec3(0.0);
+    if (s.sheen) {
+        // The pre-filtered radiance along R = 2 (N.V) N - V at the sheen's roughness.
+        float n_dot_v_raw = dot3(s.n, view);
+        float two_n_dot_v = n_dot_v_raw + n_dot_v_raw;
+        vec3 sheen_specular = specular(two_n_dot_v * s.n - view, s.sheen_roughness);
+        float scale = sheen.albedo * weight;
+        sheen_out = sheen_specular * s.sheen_color * scale;
     }
     return (diffuse + specular_ * fss_ess) * weight;
 }
@@ -568,23 +719,33 @@ vec3 transmitted_light(Surface s, vec3 path) {
     return attenuate(light, path);
 }
 
-// pbr::shade: the linear colour before exposure and tone mapping, emission and coat included.
+// pbr::shade: the linear colour before exposure and tone mapping, emission, sheen and coat
+// included.
 vec3 shade(Surface s, vec3 emissive) {
     vec3 view = normalize3(u_eye - s.position);
     float clamped = max(s.roughness, MIN_PUNCTUAL_ROUGHNESS);
     float alpha = clamped * clamped;
     vec3 color = vec3(0.0);
     vec3 coat_color = vec3(0.0);
+    vec3 sheen_color = vec3(0.0);
     vec3 path = s.transmission ? refraction_path(s, view) : vec3(0.0);
+    SheenTerms sheen = no_sheen();
+    if (s.sheen) {
+        sheen = sheen_terms(s, clamp01(dot3(s.n, view)));
+    }
     for (int i = 0; i < u_punctual_count; i++) {
         vec3 coat;
-        color = color + punctual(i, s, view, alpha, path, coat);
+        vec3 sheen_light;
+        color = color + punctual(i, s, view, alpha, path, sheen, coat, sheen_light);
         coat_color = coat_color + coat;
+        sheen_color = sheen_color + sheen_light;
     }
     if (u_has_environment) {
         vec3 coat;
-        color = color + image_based(s, view, coat);
+        vec3 sheen_light;
+        color = color + image_based(s, view, sheen, coat, sheen_light);
         coat_color = coat_color + coat;
+        sheen_color = sheen_color + sheen_light;
     }
     if (s.transmission) {
         // The backdrop replaces the part `transmission_factor` of the dielectric's diffuse
@@ -594,6 +755,10 @@ vec3 shade(Surface s, vec3 emissive) {
         vec2 ab = brdf_ab(n_dot_v, s.roughness);
         vec3 fss_ess = s.f0 * ab.x + s.f90 * ab.y;
         color = color + s.transmission_factor * s.c_diff * (1.0 - fss_ess) * light;
+    }
+    if (s.sheen) {
+        // The layer keeps 1 - max(sheenColor) E(NdotV) of the base, and adds its own lobes.
+        color = color * sheen.base_scale + sheen_color;
     }
     color = color + emissive;
     if (s.coat) {
@@ -712,6 +877,14 @@ void main() {
     vec4 thickness_texel = vec4(1.0);
     if (u_has_thickness_texture) {
         thickness_texel = texture(u_thickness_texture, uv(11));
+    }
+    vec4 sheen_color_texel = vec4(1.0);
+    if (u_has_sheen_color_texture) {
+        sheen_color_texel = texture(u_sheen_color_texture, uv(12));
+    }
+    vec4 sheen_roughness_texel = vec4(1.0);
+    if (u_has_sheen_roughness_texture) {
+        sheen_roughness_texel = texture(u_sheen_roughness_texture, uv(13));
     }
     // The projection is y-flipped (window row 0 = image row 0), so dFdy is the derivative
     // towards increasing image row, as the CPU's.
@@ -832,6 +1005,23 @@ void main() {
         }
         s.transmission_factor = clamp01(transmission);
         s.thickness = max(thickness, 0.0);
+        // KHR_materials_sheen: the colour times the sRGB texture's RGB, the roughness times
+        // the linear texture's alpha, both clamped to [0, 1].
+        s.sheen = u_sheen;
+        vec3 sheen_color = u_sheen_color;
+        if (u_has_sheen_color_texture) {
+            sheen_color = sheen_color * sheen_color_texel.rgb;
+        }
+        float sheen_roughness = u_sheen_roughness;
+        if (u_has_sheen_roughness_texture) {
+            sheen_roughness = sheen_roughness * sheen_roughness_texel.a;
+        }
+        s.sheen_color = vec3(
+            clamp01(sheen_color.r),
+            clamp01(sheen_color.g),
+            clamp01(sheen_color.b)
+        );
+        s.sheen_roughness = clamp01(sheen_roughness);
         rgb = shade(s, emissive);
     }
     rgb = tonemap(rgb);
@@ -850,6 +1040,7 @@ pub(crate) fn fragment_source() -> String {
     source += &int("MAX_LIGHTS", MAX_LIGHTS);
     source += &int("LEVELS", SPECULAR_LEVELS);
     source += &int("BRDF_TABLE_SIZE", BRDF_TABLE_SIZE);
+    source += &int("TEXTURE_SLOTS", TEXTURE_SLOTS);
     source += &float("PI", std::f32::consts::PI);
     source += &float("INV_PI", std::f32::consts::FRAC_1_PI);
     source += &float("DIELECTRIC_F0", DIELECTRIC_F0);
@@ -867,6 +1058,16 @@ pub(crate) fn fragment_source() -> String {
     source += &float("SH_Y2", SH_Y2);
     source += &float("SH_Y20", SH_Y20);
     source += &float("SH_Y22", SH_Y22);
+    // The sheen (sheen.rs): the least normal float, log2(e), 1 / (2 pi) and the fit of Lambda.
+    source += &float("FLT_MIN_NORMAL", f32::MIN_POSITIVE);
+    source += &float("LOG2_E", std::f32::consts::LOG2_E);
+    source += &float("HALF_INV_PI", 0.5 / std::f32::consts::PI);
+    let floats = |name: &str, values: [f32; 5]| {
+        let values: Vec<String> = values.iter().map(|v| format!("{v:?}")).collect();
+        format!("const float {name}[5] = float[5]({});\n", values.join(", "))
+    };
+    source += &floats("LAMBDA_AT_ONE", LAMBDA_FIT.map(|[at_one, _]| at_one));
+    source += &floats("LAMBDA_AT_ZERO", LAMBDA_FIT.map(|[_, at_zero]| at_zero));
     source += FRAGMENT_BODY;
     source
 }
@@ -908,6 +1109,9 @@ pub(crate) struct PbrUniforms {
     pub(crate) backdrop: Option<glow::UniformLocation>,
     pub(crate) backdrop_last_level: Option<glow::UniformLocation>,
     pub(crate) backdrop_view_projection: Option<glow::UniformLocation>,
+    pub(crate) sheen: Option<glow::UniformLocation>,
+    pub(crate) sheen_color: Option<glow::UniformLocation>,
+    pub(crate) sheen_roughness: Option<glow::UniformLocation>,
     pub(crate) tangent_sign: Option<glow::UniformLocation>,
     pub(crate) texcoord_sets: Option<glow::UniformLocation>,
     pub(crate) frame_set: Option<glow::UniformLocation>,
@@ -931,6 +1135,7 @@ pub(crate) struct PbrUniforms {
     pub(crate) level_row: Option<glow::UniformLocation>,
     pub(crate) level_size: Option<glow::UniformLocation>,
     pub(crate) brdf: Option<glow::UniformLocation>,
+    pub(crate) sheen_albedo: Option<glow::UniformLocation>,
 }
 
 /// Looks up every uniform of the PBR program.
@@ -972,6 +1177,9 @@ pub(crate) unsafe fn pbr_uniforms(gl: &glow::Context, program: glow::Program) ->
         backdrop: at("u_backdrop"),
         backdrop_last_level: at("u_backdrop_last_level"),
         backdrop_view_projection: at("u_backdrop_view_projection"),
+        sheen: at("u_sheen"),
+        sheen_color: at("u_sheen_color"),
+        sheen_roughness: at("u_sheen_roughness"),
         tangent_sign: at("u_tangent_sign"),
         texcoord_sets: at("u_texcoord_set"),
         frame_set: at("u_frame_set"),
@@ -995,6 +1203,7 @@ pub(crate) unsafe fn pbr_uniforms(gl: &glow::Context, program: glow::Program) ->
         level_row: at("u_level_row"),
         level_size: at("u_level_size"),
         brdf: at("u_brdf"),
+        sheen_albedo: at("u_sheen_albedo"),
     }
 }
 
@@ -1039,21 +1248,32 @@ impl LightArrays {
     }
 }
 
+/// The rules' lookup tables on the GPU ([`crate::resources::GpuScene`]'s), read by
+/// `texelFetch`.
+#[derive(Clone, Copy)]
+pub(crate) struct LookupTables {
+    /// The split-sum table.
+    pub(crate) brdf: Option<glow::Texture>,
+    /// The sheen's albedo table.
+    pub(crate) sheen_albedo: Option<glow::Texture>,
+}
+
 /// Sets the frame's uniforms of the PBR program (in use): texture units, the eye, the lights,
 /// exposure and tone map, the environment, whose atlas it binds to [`UNIT_ENVIRONMENT`], the
-/// split-sum table (`brdf`, on [`UNIT_BRDF`]), and the backdrop of a frame with transmission
-/// (on [`UNIT_BACKDROP`], with `lighting.transmission`'s view-projection), leaving unit 0
-/// active.
+/// split-sum table (`tables.brdf`, on [`UNIT_BRDF`]), the sheen's albedo table
+/// (`tables.sheen_albedo`, on [`UNIT_SHEEN_ALBEDO`]), and the backdrop of a frame with
+/// transmission (on [`UNIT_BACKDROP`], with `lighting.transmission`'s view-projection), leaving
+/// unit 0 active.
 ///
 /// # Safety
-/// `gl` must be current on this thread with the PBR program in use; `environment`, `brdf`
+/// `gl` must be current on this thread with the PBR program in use; `environment`, the tables
 /// and `backdrop` must be its objects.
 pub(crate) unsafe fn set_frame_uniforms(
     gl: &glow::Context,
     u: &PbrUniforms,
     lighting: &PbrLighting,
     environment: Option<&GpuEnvironment>,
-    brdf: Option<glow::Texture>,
+    tables: LookupTables,
     backdrop: Option<&GpuBackdrop>,
 ) {
     let lights = LightArrays::new(&lighting.lights);
@@ -1066,6 +1286,7 @@ pub(crate) unsafe fn set_frame_uniforms(
         gl.uniform_1_i32(u.environment.as_ref(), unit(UNIT_ENVIRONMENT));
         gl.uniform_1_i32(u.brdf.as_ref(), unit(UNIT_BRDF));
         gl.uniform_1_i32(u.backdrop.as_ref(), unit(UNIT_BACKDROP));
+        gl.uniform_1_i32(u.sheen_albedo.as_ref(), unit(UNIT_SHEEN_ALBEDO));
         gl.uniform_3_f32_slice(u.eye.as_ref(), &lighting.eye.to_array());
         gl.uniform_1_i32(u.light_count.as_ref(), lights.count);
         gl.uniform_3_f32_slice(u.light_color.as_ref(), &lights.color);
@@ -1087,7 +1308,10 @@ pub(crate) unsafe fn set_frame_uniforms(
         gl.bind_texture(glow::TEXTURE_2D, environment.map(|e| e.atlas));
         gl.active_texture(glow::TEXTURE0 + UNIT_BRDF);
         gl.bind_sampler(UNIT_BRDF, None);
-        gl.bind_texture(glow::TEXTURE_2D, brdf);
+        gl.bind_texture(glow::TEXTURE_2D, tables.brdf);
+        gl.active_texture(glow::TEXTURE0 + UNIT_SHEEN_ALBEDO);
+        gl.bind_sampler(UNIT_SHEEN_ALBEDO, None);
+        gl.bind_texture(glow::TEXTURE_2D, tables.sheen_albedo);
         gl.active_texture(glow::TEXTURE0 + UNIT_BACKDROP);
         gl.bind_sampler(UNIT_BACKDROP, None);
         gl.bind_texture(glow::TEXTURE_2D, backdrop.map(|b| b.texture));
@@ -1133,5 +1357,61 @@ unsafe fn set_environment_uniforms(
         gl.uniform_3_f32_slice(u.irradiance_sh.as_ref(), &sh);
         gl.uniform_1_i32_slice(u.level_row.as_ref(), &maps.rows);
         gl.uniform_1_i32_slice(u.level_size.as_ref(), &maps.sizes);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The fragment shader declares one sampler per unit up to [`UNIT_SHEEN_ALBEDO`].
+    #[test]
+    fn the_fragment_shader_reads_one_sampler_per_unit() {
+        let source = fragment_source();
+        let samplers = source.matches("uniform sampler2D ").count();
+        assert_eq!(samplers as u32, FRAGMENT_SAMPLERS);
+        assert_eq!(FRAGMENT_SAMPLERS, 18);
+        assert_eq!(
+            source.matches("uniform sampler2D u_has").count(),
+            0,
+            "flags are bools"
+        );
+        for (has, sampler) in PBR_TEXTURES {
+            assert!(source.contains(&format!("uniform bool {has};")), "{has}");
+            assert!(
+                source.contains(&format!("uniform sampler2D {sampler};")),
+                "{sampler}"
+            );
+        }
+    }
+
+    /// A context with fewer fragment texture units than the program's samplers is refused
+    /// with one line; OpenGL 3.3's guaranteed 16 is too few, llvmpipe's 32 enough.
+    #[test]
+    fn too_few_texture_units_are_refused() {
+        for units in [0, 16, 17] {
+            let error = check_texture_units(units).expect_err("too few");
+            assert!(!error.contains('\n'), "{error}");
+            assert!(error.contains("GL_MAX_TEXTURE_IMAGE_UNITS"), "{error}");
+            assert!(error.contains(&format!("offers {units} ")), "{error}");
+        }
+        assert!(check_texture_units(18).is_ok());
+        assert!(check_texture_units(32).is_ok());
+    }
+
+    /// The fit of `Λ` reaches the shader as the rules hold it.
+    #[test]
+    fn the_lambda_fit_is_the_rules() {
+        let source = fragment_source();
+        let at_one: Vec<String> = LAMBDA_FIT.iter().map(|[v, _]| format!("{v:?}")).collect();
+        let at_zero: Vec<String> = LAMBDA_FIT.iter().map(|[_, v]| format!("{v:?}")).collect();
+        assert!(source.contains(&format!(
+            "LAMBDA_AT_ONE[5] = float[5]({});",
+            at_one.join(", ")
+        )));
+        assert!(source.contains(&format!(
+            "LAMBDA_AT_ZERO[5] = float[5]({});",
+            at_zero.join(", ")
+        )));
     }
 }

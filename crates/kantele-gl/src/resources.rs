@@ -1,17 +1,20 @@
 //! Scene data in GL objects: one vertex array + vertex buffer + index buffer per mesh, one RGBA8 /
 //! SRGB8_ALPHA8 texture with its complete mip chain per texture, one sampler object per texture
-//! binding of a material, for a PBR scene the split-sum table and (with an environment) its
-//! pre-filtered levels as float textures; and a frame's transmission backdrop, uploaded with
-//! the rules' own mip chain.
+//! binding of a material, for a PBR scene the split-sum table, (with a sheen) the sheen's
+//! albedo table and (with an environment) its pre-filtered levels as float textures; and a
+//! frame's transmission backdrop, uploaded with the rules' own mip chain.
 
 use glow::HasContext;
-use kantele_rules::scene::{Material, Mesh, Scene, Shading};
+use kantele_rules::scene::{Material, Mesh, Scene, Shading, TextureBinding};
 use kantele_rules::shade::environment::{
     brdf_table, Environment, BRDF_TABLE_SIZE, SPECULAR_LEVELS,
 };
+use kantele_rules::shade::sheen::sheen_table;
 use kantele_rules::shade::texture::{ColorSpace, Filter, MinFilter, Sampler, Texture, Wrap};
 use kantele_rules::shade::transmission::Backdrop;
 use kantele_rules::vertex::{PbrVertex, StandardVertex};
+
+use crate::pbr::PBR_TEXTURES;
 
 /// Floats per vertex: position 3, normal 3, texcoord 2, colour 4.
 pub(crate) const VERTEX_FLOATS: usize = 12;
@@ -39,12 +42,14 @@ pub(crate) struct GpuScene {
     pub(crate) emissive_samplers: Vec<Option<glow::Sampler>>,
     /// Per material: the sampler objects of its PBR textures ([`Material::pbr_textures`]),
     /// where it has them.
-    pub(crate) pbr_samplers: Vec<[Option<glow::Sampler>; 10]>,
+    pub(crate) pbr_samplers: Vec<[Option<glow::Sampler>; PBR_TEXTURES.len()]>,
     /// The environment of a PBR scene, if it has one.
     pub(crate) environment: Option<GpuEnvironment>,
     /// The split-sum table of a PBR scene ([`upload_brdf_table`]): image-based light and
     /// transmission read it.
     pub(crate) brdf: Option<glow::Texture>,
+    /// The sheen's albedo table ([`upload_sheen_table`]), for a PBR scene with a sheen.
+    pub(crate) sheen_albedo: Option<glow::Texture>,
 }
 
 /// An environment on the GPU, read by the PBR program with `texelFetch` only: the
@@ -344,6 +349,17 @@ pub(crate) unsafe fn upload_brdf_table(gl: &glow::Context) -> Result<glow::Textu
     unsafe { upload_float_texture(gl, glow::RG32F, glow::RG, size, &table) }
 }
 
+/// Uploads the sheen's albedo table of [`sheen_table`] as a `BRDF_TABLE_SIZE²` `GL_R32F`
+/// texture (x: `NdotV`, y: roughness, as the split-sum table), read by `texelFetch` only.
+///
+/// # Safety
+/// `gl` must be current on this thread.
+pub(crate) unsafe fn upload_sheen_table(gl: &glow::Context) -> Result<glow::Texture, String> {
+    let size = (BRDF_TABLE_SIZE, BRDF_TABLE_SIZE);
+    // SAFETY: forwarded caller's contract; the table holds BRDF_TABLE_SIZE² R texels.
+    unsafe { upload_float_texture(gl, glow::R32F, glow::RED, size, sheen_table()) }
+}
+
 /// A frame's backdrop on the GPU: every level of the rules' chain ([`Backdrop::level`]) in one
 /// `GL_RGB32F` texture with explicit levels, rows in memory order (the backdrop's top row is
 /// GL's `t = 0` row, where the rules' `v = 0` points), sampled trilinearly
@@ -497,8 +513,10 @@ impl GpuScene {
                     None => None,
                 };
                 gpu.emissive_samplers.push(emissive);
-                let mut pbr = [None; 10];
-                for (slot, binding) in pbr.iter_mut().zip(material.pbr_textures()) {
+                let mut pbr = [None; PBR_TEXTURES.len()];
+                let textures: [Option<TextureBinding>; PBR_TEXTURES.len()] =
+                    material.pbr_textures();
+                for (slot, binding) in pbr.iter_mut().zip(textures) {
                     if let Some(b) = binding {
                         // SAFETY: forwarded caller's contract.
                         *slot = Some(unsafe { create_sampler(gl, &b.sampler) }?);
@@ -511,6 +529,12 @@ impl GpuScene {
                 let brdf = unsafe { upload_brdf_table(gl) }
                     .map_err(|e| format!("split-sum table: {e}"))?;
                 gpu.brdf = Some(brdf);
+            }
+            if scene.shading == Shading::Pbr && scene.materials.iter().any(Material::has_sheen) {
+                // SAFETY: forwarded caller's contract.
+                let table = unsafe { upload_sheen_table(gl) }
+                    .map_err(|e| format!("sheen albedo table: {e}"))?;
+                gpu.sheen_albedo = Some(table);
             }
             if let (Shading::Pbr, Some(light)) = (scene.shading, &scene.environment) {
                 // SAFETY: forwarded caller's contract.
@@ -559,6 +583,9 @@ impl GpuScene {
                 gl.delete_texture(e.atlas);
             }
             if let Some(t) = self.brdf.take() {
+                gl.delete_texture(t);
+            }
+            if let Some(t) = self.sheen_albedo.take() {
                 gl.delete_texture(t);
             }
         }

@@ -3,8 +3,8 @@
 //! point: punctual lights (directional, point with a range, spot) over dielectrics and metals of
 //! several roughnesses under every tone map, the headlight, the built-in studio environment
 //! (rotated, dimmed, with occlusion), metallic-roughness and normal textures (front and back
-//! faces, and the normal pass), unlit materials; and a Lambert scene that the PBR data leaves
-//! unchanged. A large plane fills the picture, so every pixel is compared; the tolerance only
+//! faces, and the normal pass), unlit materials, the specular, IOR, clear-coat and sheen
+//! extensions; and a Lambert scene that the PBR data leaves unchanged. A large plane fills the picture, so every pixel is compared; the tolerance only
 //! covers float rounding (GL's arithmetic differs from the CPU's in the last bits).
 //!
 //! Every test skips (prints "skipping: <reason>") where no headless GL context can be created.
@@ -23,6 +23,7 @@ use kantele_rules::shade::environment::EnvironmentLight;
 use kantele_rules::shade::pbr::{
     shade, tonemap, ClearcoatLayer, PbrLighting, Surface, Tonemap, DIELECTRIC_F0,
 };
+use kantele_rules::shade::sheen::SheenLayer;
 use kantele_rules::shade::texture::{ColorSpace, Sampler, Texture};
 
 use crate::common::gl_or_skip;
@@ -185,6 +186,8 @@ struct Params {
     specular_weight: f32,
     /// Clear coat factor and roughness (its normal is the plane's); 0: none.
     clearcoat: (f32, f32),
+    /// Sheen colour and roughness, after their textures; `None`: no sheen.
+    sheen: Option<(Vec3, f32)>,
 }
 
 impl Default for Params {
@@ -199,6 +202,7 @@ impl Default for Params {
             dielectric_f0: Vec3::splat(DIELECTRIC_F0),
             specular_weight: 1.0,
             clearcoat: (0.0, 0.0),
+            sheen: None,
         }
     }
 }
@@ -224,7 +228,10 @@ fn expected(lighting: &PbrLighting, params: &Params, n: Vec3, p: Vec3) -> Vec3 {
                 roughness: Scalar.splat_f32(roughness),
                 normal: splat3(plane_normal()),
             }),
-            sheen: None,
+            sheen: params.sheen.map(|(color, roughness)| SheenLayer {
+                color: splat3(color.clamp(Vec3::ZERO, Vec3::ONE)),
+                roughness: Scalar.splat_f32(roughness.clamp(0.0, 1.0)),
+            }),
             transmission: None,
         };
         lane0(shade(Scalar, lighting, &surface, &splat3(params.emissive)))
@@ -731,4 +738,119 @@ fn specular_ior_and_clear_coat_follow_the_rules() {
         let worst = check_scene(&mut gl, scene, EYE, &params, &what);
         eprintln!("{what}: largest difference {worst:.2e}");
     }
+}
+
+/// An eye low over the plane: its views meet the plane at `NdotV` from 0.28 to 0.94, so the
+/// sheen's `Λ(NdotV)` takes both branches of its fit.
+const LOW_EYE: Vec3 = Vec3::new(0.45, -1.27, 1.93);
+
+/// `KHR_materials_sheen` — factors at several roughnesses (the smallest under the punctual
+/// lights' floor, a colour above 1 that is clamped), textures (an sRGB colour texture, the
+/// roughness in a linear texture's alpha), under a clear coat, over a metal — under three
+/// punctual lights and the studio, seen from above and from low over the plane, as the rules
+/// shade it. A sheen of colour black is no sheen: its roughness and textures leave the
+/// picture bit for bit as without them.
+#[test]
+fn sheen_follows_the_rules() {
+    let Some(mut gl) = gl_or_skip() else {
+        return;
+    };
+    // Sheen colour (sRGB): a pale rose. Roughness: alpha 0.6, the other channels different so
+    // that a wrong channel shows. llvmpipe decodes sRGB texels with an approximation (0.45591
+    // for 180, where the rules and the formula give 0.45641): most of the textured cases'
+    // difference, about 6e-4 of the colour texture alone.
+    let sheen_color = [255u8, 180, 200, 255];
+    let sheen_roughness = [30u8, 220, 90, 153];
+    let color_texture =
+        Texture::from_rgba8(2, 2, &sheen_color.repeat(4), ColorSpace::Srgb).expect("texture");
+    let decoded = color_texture
+        .sample_lod(&Sampler::default(), Vec2::splat(0.5), 0.0)
+        .truncate();
+    let color_texture = Arc::new(color_texture);
+    let base = Vec3::new(0.25, 0.05, 0.1);
+    // (sheen colour, sheen roughness, metallic, coat factor, coat roughness, textured)
+    let cases = [
+        (Vec3::new(1.0, 0.6, 0.7), 0.0, 0.0, 0.0, 0.0, false),
+        (Vec3::new(1.0, 0.6, 0.7), 0.3, 0.0, 0.0, 0.0, false),
+        (Vec3::new(0.9, 0.8, 0.3), 0.6, 0.0, 0.0, 0.0, false),
+        (Vec3::new(1.5, 1.0, 0.5), 1.0, 0.0, 0.0, 0.0, false),
+        (Vec3::ONE, 0.8, 0.0, 0.0, 0.0, true),
+        (Vec3::new(1.0, 0.6, 0.7), 0.5, 0.0, 0.8, 0.2, false),
+        (Vec3::new(0.8, 0.9, 1.0), 0.4, 1.0, 1.0, 0.5, true),
+    ];
+    for (color, roughness, metallic, coat_factor, coat_rough, textured) in cases {
+        let mut material = Material {
+            base_color_factor: base.extend(1.0),
+            metallic,
+            roughness: 0.7,
+            clearcoat: coat_factor,
+            clearcoat_roughness: coat_rough,
+            sheen_color: color,
+            sheen_roughness: roughness,
+            ..Material::default()
+        };
+        let mut params = Params {
+            base,
+            metallic,
+            roughness: 0.7,
+            clearcoat: (coat_factor, coat_rough),
+            sheen: Some((color, roughness)),
+            ..Params::default()
+        };
+        let mut textures = Vec::new();
+        if textured {
+            material.sheen_color_texture = binding(textures.len());
+            textures.push(color_texture.clone());
+            material.sheen_roughness_texture = binding(textures.len());
+            textures.push(constant_texture(sheen_roughness));
+            params.sheen = Some((color * decoded, roughness * unorm(sheen_roughness[3])));
+        }
+        let mut scene = scene(material, textures, lights());
+        scene.environment = Some(EnvironmentLight {
+            intensity: 0.9,
+            rotation: 0.4,
+            ..EnvironmentLight::studio()
+        });
+        for (eye, seen) in [(EYE, "above"), (LOW_EYE, "low")] {
+            let what = format!(
+                "sheen {color} roughness {roughness} metallic {metallic} coat \
+                 {coat_factor}/{coat_rough} textured {textured}, seen from {seen}"
+            );
+            let worst = check_scene(&mut gl, scene.clone(), eye, &params, &what);
+            eprintln!("{what}: largest difference {worst:.2e}");
+        }
+    }
+
+    // Black sheen: no sheen, whatever its roughness and textures.
+    let material = Material {
+        base_color_factor: base.extend(1.0),
+        metallic: 0.0,
+        roughness: 0.7,
+        ..Material::default()
+    };
+    let plain = Arc::new(scene(material.clone(), vec![color_texture], lights()));
+    let mut black = (*plain).clone();
+    black.textures.push(constant_texture(sheen_roughness));
+    black.materials[0] = Material {
+        sheen_roughness: 0.5,
+        sheen_color_texture: binding(0),
+        sheen_roughness_texture: binding(1),
+        ..material
+    };
+    let black = Arc::new(black);
+    let view = frame(&plain, LOW_EYE, Pass::Color);
+    let a = render(&mut gl, &plain, &view);
+    let b = render(&mut gl, &black, &view);
+    assert!(a.color == b.color, "a black sheen changes the picture");
+    let lighting = PbrLighting::for_frame(&black, &view);
+    let params = Params {
+        base,
+        metallic: 0.0,
+        roughness: 0.7,
+        ..Params::default()
+    };
+    let worst = check_every_pixel(&b, &view, "black sheen", |p| {
+        expected(&lighting, &params, plane_normal(), p)
+    });
+    eprintln!("black sheen: largest difference {worst:.2e}");
 }

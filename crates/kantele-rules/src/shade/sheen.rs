@@ -81,9 +81,10 @@ impl<L: Lanes> SheenLayer<L> {
     }
 }
 
-/// Estevez and Kulla's fit of the sheen's `Λ`: five coefficients at `α = 0` and at `α = 1`,
-/// mixed by `(1 − α)²`.
-const LAMBDA_FIT: [[f32; 2]; 5] = [
+/// Estevez and Kulla's fit of the sheen's `Λ`: five coefficients `(a, b, c, d, e)`, each as
+/// `[at α = 1, at α = 0]`, mixed by `(1 − α)²` (public for the OpenGL shader, which follows
+/// [`sheen_lambda`]).
+pub const LAMBDA_FIT: [[f32; 2]; 5] = [
     [21.5473, 25.3245],
     [3.82987, 3.32435],
     [0.19823, 0.16801],
