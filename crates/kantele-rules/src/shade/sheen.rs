@@ -118,7 +118,7 @@ fn lambda_exponent<L: Lanes>(lanes: L, fit: &[L::F32; 5], x: L::F32) -> L::F32 {
 }
 
 /// The sheen's `Λ(cos θ)` for `cos θ` in [0, 1]: `exp(L(cos θ))` below ½,
-/// `exp(2 L(½) − L(1 − cos θ))` from there, `L` the fit's exponent ([`lambda_exponent`]) and
+/// `exp(2 L(½) − L(1 − cos θ))` from there, `L` the fit's exponent (`lambda_exponent`) and
 /// `twice_at_half = 2 L(½)`. One evaluation of `L`, at `cos θ` or `1 − cos θ`.
 #[inline(always)]
 pub fn sheen_lambda<L: Lanes>(
