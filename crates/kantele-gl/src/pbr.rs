@@ -329,6 +329,7 @@ struct SheenTerms {
     float albedo;
     float base_scale;
     float fit[5];
+    float twice_at_half;
     float lambda_view;
 };
 
@@ -340,18 +341,18 @@ float lambda_exponent(float fit[5], float x) {
     return fit[0] / (1.0 + fit[1] * power) + fit[3] * x + fit[4];
 }
 
-// sheen::sheen_lambda: exp(L(cos)) below 1/2, exp(2 L(1/2) - L(1 - cos)) from there.
-float sheen_lambda(float fit[5], float cos_theta) {
-    float below = lambda_exponent(fit, cos_theta);
-    float at_half = lambda_exponent(fit, 0.5);
-    float above = lambda_exponent(fit, 1.0 - cos_theta);
-    float exponent = cos_theta < 0.5 ? below : at_half + at_half - above;
+// sheen::sheen_lambda: exp(L(cos)) below 1/2, exp(2 L(1/2) - L(1 - cos)) from there, with
+// twice_at_half = 2 L(1/2); one evaluation of L.
+float sheen_lambda(float fit[5], float twice_at_half, float cos_theta) {
+    bool below_half = cos_theta < 0.5;
+    float l = lambda_exponent(fit, below_half ? cos_theta : 1.0 - cos_theta);
+    float exponent = below_half ? l : twice_at_half - l;
     return exp2(clamp(exponent * LOG2_E, -126.0, 127.0));
 }
 
 // sheen::charlie_v: 1 / ((1 + Lambda(NdotV) + Lambda(NdotL)) 4 NdotV NdotL), at most 1.
 float charlie_v(SheenTerms t, float n_dot_l, float n_dot_v) {
-    float lambda_light = sheen_lambda(t.fit, n_dot_l);
+    float lambda_light = sheen_lambda(t.fit, t.twice_at_half, n_dot_l);
     float denominator = (1.0 + t.lambda_view + lambda_light) * 4.0 * n_dot_v * n_dot_l;
     // 1 / 0 is infinite, and clamps to 1.
     return denominator > 0.0 ? min(1.0 / denominator, 1.0) : 1.0;
@@ -620,7 +621,9 @@ SheenTerms sheen_terms(Surface s, float n_dot_v) {
     }
     t.exponent = 0.5 / t.alpha;
     t.base_scale = max(1.0 - brightest * t.albedo, 0.0);
-    t.lambda_view = sheen_lambda(t.fit, n_dot_v);
+    float at_half = lambda_exponent(t.fit, 0.5);
+    t.twice_at_half = at_half + at_half;
+    t.lambda_view = sheen_lambda(t.fit, t.twice_at_half, n_dot_v);
     return t;
 }
 
@@ -634,6 +637,7 @@ SheenTerms no_sheen() {
     for (int k = 0; k < 5; k++) {
         t.fit[k] = 0.0;
     }
+    t.twice_at_half = 0.0;
     t.lambda_view = 0.0;
     return t;
 }

@@ -34,6 +34,19 @@ fn render_set(dir: &TempDir, prefix: &str, outputs: &[(&str, &str)], extra: &[&s
     kantele(&args)
 }
 
+/// Each of `outputs` written as `whole.{name}` equals `banded.{name}` byte for byte.
+fn assert_banded_equals_whole(dir: &TempDir, outputs: &[(&str, &str)]) {
+    for (_, name) in outputs {
+        let a = std::fs::read(dir.path(&format!("whole.{name}"))).unwrap();
+        let b = std::fs::read(dir.path(&format!("banded.{name}"))).unwrap();
+        assert!(a.len() > 100, "{name}: {} bytes", a.len());
+        assert!(
+            a == b,
+            "{name}: the banded file differs from the unbanded one"
+        );
+    }
+}
+
 #[test]
 fn banded_outputs_equal_unbanded_outputs_byte_for_byte() {
     let dir = TempDir::new("bands");
@@ -63,15 +76,7 @@ fn banded_outputs_equal_unbanded_outputs_byte_for_byte() {
             &["--depth-kind", depth_kind, "--frame-memory", "1"],
         );
         ok(&banded);
-        for (_, name) in outputs.iter() {
-            let a = std::fs::read(dir.path(&format!("whole.{name}"))).unwrap();
-            let b = std::fs::read(dir.path(&format!("banded.{name}"))).unwrap();
-            assert!(a.len() > 100, "{name}: {} bytes", a.len());
-            assert!(
-                a == b,
-                "{name}: the banded file differs from the unbanded one"
-            );
-        }
+        assert_banded_equals_whole(&dir, outputs);
         let color = outputs[0].1;
         assert_eq!(
             sidecar_without_timing(&dir.path(&format!("whole.{color}.json"))),
@@ -101,15 +106,7 @@ fn banded_multisampled_outputs_equal_unbanded_outputs_byte_for_byte() {
         outputs,
         &["--msaa", "4", "--frame-memory", "1"],
     ));
-    for (_, name) in outputs {
-        let a = std::fs::read(dir.path(&format!("whole.{name}"))).unwrap();
-        let b = std::fs::read(dir.path(&format!("banded.{name}"))).unwrap();
-        assert!(a.len() > 100, "{name}: {} bytes", a.len());
-        assert!(
-            a == b,
-            "{name}: the banded file differs from the unbanded one"
-        );
-    }
+    assert_banded_equals_whole(&dir, outputs);
     // Multisampled edges: the picture has levels between the teapot's and the background's.
     let png = image::open(dir.path("whole.c.png")).unwrap().into_rgba8();
     let mut levels: Vec<[u8; 4]> = png.pixels().map(|p| p.0).collect();

@@ -6,6 +6,8 @@ pub mod pbr;
 pub mod sample_lanes;
 pub mod sheen;
 pub mod spec_gloss;
+#[cfg(test)]
+mod test_support;
 pub mod texel;
 mod texel_lanes;
 pub mod texture;

@@ -8,19 +8,8 @@ use kantele_lanes::{F32x8, Lanes, Scalar};
 
 use super::*;
 use crate::scene::{LightKind, PunctualLight};
-use crate::shade::environment::{Environment, EnvironmentLight};
-
-fn splat3(v: Vec3) -> [<Scalar as Lanes>::F32; 3] {
-    [
-        Scalar.splat_f32(v.x),
-        Scalar.splat_f32(v.y),
-        Scalar.splat_f32(v.z),
-    ]
-}
-
-fn lane0(v: [<Scalar as Lanes>::F32; 3]) -> Vec3 {
-    Vec3::new(v[0].extract(0), v[1].extract(0), v[2].extract(0))
-}
+use crate::shade::environment::EnvironmentLight;
+use crate::shade::test_support::{furnace_lighting, lane0, splat3, white_environment};
 
 fn surface(
     base: Vec3,
@@ -221,10 +210,7 @@ fn tone_maps_keep_range_and_order() {
 /// roughness 1 and grazing angles; stated in docs/rendering-rules.md), and never above 1.
 #[test]
 fn white_furnace() {
-    let width = 64;
-    let white = vec![Vec3::ONE; width * width / 2];
-    let environment =
-        Environment::from_equirect(width as u32, width as u32 / 2, &white).expect("environment");
+    let environment = white_environment();
     // Irradiance ÷ π of a uniform radiance-1 sky is 1 in every direction.
     for n in [
         Vec3::X,
@@ -250,18 +236,7 @@ fn white_furnace() {
             );
         }
     }
-    let lighting = PbrLighting {
-        lights: Vec::new(),
-        environment: Some(EnvironmentLight {
-            environment: std::sync::Arc::new(environment),
-            intensity: 1.0,
-            rotation: 0.0,
-        }),
-        eye: Vec3::new(0.0, 0.0, 10.0),
-        exposure: 1.0,
-        tonemap: Tonemap::None,
-        transmission: None,
-    };
+    let lighting = furnace_lighting(Vec3::new(0.0, 0.0, 10.0));
     for roughness in [0.0f32, 0.25, 0.5, 0.75, 1.0] {
         for i in 0..20 {
             let z = (i as f32 + 0.5) / 20.0;
@@ -445,23 +420,8 @@ fn a_clear_coat_layers_over_the_base() {
 /// and of the glTF sample viewer, which do not compensate it.
 #[test]
 fn a_clear_coat_conserves_energy_in_the_furnace() {
-    let width = 64;
-    let white = vec![Vec3::ONE; width * width / 2];
-    let environment =
-        Environment::from_equirect(width as u32, width as u32 / 2, &white).expect("environment");
     let eye = Vec3::new(0.0, 0.0, 10.0);
-    let lighting = PbrLighting {
-        lights: Vec::new(),
-        environment: Some(EnvironmentLight {
-            environment: std::sync::Arc::new(environment),
-            intensity: 1.0,
-            rotation: 0.0,
-        }),
-        eye,
-        exposure: 1.0,
-        tonemap: Tonemap::None,
-        transmission: None,
-    };
+    let lighting = furnace_lighting(eye);
     for coat_roughness in [0.0f32, 0.5, 1.0] {
         for i in 0..20 {
             let z = 0.3 + 0.7 * (i as f32 + 0.5) / 20.0;

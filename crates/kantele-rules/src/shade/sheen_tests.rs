@@ -3,14 +3,13 @@
 //! sheen under one light against the formulas, and the white furnace.
 
 use std::f64::consts::PI;
-use std::sync::Arc;
 
 use glam::{DVec3, Vec3};
 use kantele_lanes::{dispatch, F32x8, Isa, LaneKernel, Lanes, Scalar};
 
 use super::*;
-use crate::shade::environment::{Environment, EnvironmentLight};
 use crate::shade::pbr::{shade, FrameLight, PbrLighting, Surface, Tonemap, DIELECTRIC_F0};
+use crate::shade::test_support::{furnace_lighting, lane0, splat3};
 
 #[test]
 fn log2_matches_f64() {
@@ -162,18 +161,6 @@ fn every_instruction_set_computes_the_same_bits() {
     }
 }
 
-fn splat3(v: Vec3) -> [<Scalar as Lanes>::F32; 3] {
-    [
-        Scalar.splat_f32(v.x),
-        Scalar.splat_f32(v.y),
-        Scalar.splat_f32(v.z),
-    ]
-}
-
-fn lane0(v: [<Scalar as Lanes>::F32; 3]) -> Vec3 {
-    Vec3::new(v[0].extract(0), v[1].extract(0), v[2].extract(0))
-}
-
 fn sheen_surface(base: Vec3, n: Vec3, color: Vec3, roughness: f32) -> Surface<Scalar> {
     Surface {
         base: splat3(base),
@@ -250,22 +237,7 @@ fn a_sheen_under_a_directional_light_matches_the_formulas() {
 /// exceeds 1 (see the albedo table's test) and the base is scaled by 0.
 #[test]
 fn a_sheen_keeps_the_white_furnace() {
-    let width = 64;
-    let white = vec![Vec3::ONE; width * width / 2];
-    let environment =
-        Environment::from_equirect(width as u32, width as u32 / 2, &white).expect("environment");
-    let lighting = PbrLighting {
-        lights: Vec::new(),
-        environment: Some(EnvironmentLight {
-            environment: Arc::new(environment),
-            intensity: 1.0,
-            rotation: 0.0,
-        }),
-        eye: Vec3::new(0.0, 0.0, 10.0),
-        exposure: 1.0,
-        tonemap: Tonemap::None,
-        transmission: None,
-    };
+    let lighting = furnace_lighting(Vec3::new(0.0, 0.0, 10.0));
     for roughness in [0.0f32, 0.3, 0.6, 1.0] {
         for i in 0..16 {
             let z = (i as f32 + 0.5) / 16.0;

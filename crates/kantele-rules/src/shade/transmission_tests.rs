@@ -9,18 +9,7 @@ use kantele_lanes::{dispatch, F32x8, Isa, LaneKernel, Lanes, Scalar};
 
 use super::*;
 use crate::shade::pbr::{self, PbrLighting, Surface, Tonemap, DIELECTRIC_F0};
-
-fn splat3(v: Vec3) -> [<Scalar as Lanes>::F32; 3] {
-    [
-        Scalar.splat_f32(v.x),
-        Scalar.splat_f32(v.y),
-        Scalar.splat_f32(v.z),
-    ]
-}
-
-fn lane0(v: [<Scalar as Lanes>::F32; 3]) -> Vec3 {
-    Vec3::new(v[0].extract(0), v[1].extract(0), v[2].extract(0))
-}
+use crate::shade::test_support::{lane0, splat3};
 
 /// A `w` × `h` picture whose pixel (x, y) is (x, y, x + 10 y).
 fn ramp(w: u32, h: u32) -> Vec<[f32; 4]> {

@@ -78,6 +78,15 @@ fn floor(material: usize, repeat: f32) -> Mesh {
     }
 }
 
+/// What a built-in PBR scene reports: its camera (the scene's own) and one entry per light.
+fn built_in_info(scene: &Scene) -> SceneInfo {
+    SceneInfo {
+        camera_from_file: true,
+        lights: scene.lights.iter().map(|_| "light".to_string()).collect(),
+        ..SceneInfo::default()
+    }
+}
+
 fn draw(mesh: usize, model: Mat4, name: String, node_index: usize) -> Draw {
     Draw {
         mesh,
@@ -144,11 +153,7 @@ pub fn spheres() -> (Scene, SceneInfo) {
         resolution: (800, 800),
         ..Scene::default()
     };
-    let info = SceneInfo {
-        camera_from_file: true,
-        lights: scene.lights.iter().map(|_| "light".to_string()).collect(),
-        ..SceneInfo::default()
-    };
+    let info = built_in_info(&scene);
     (scene, info)
 }
 
@@ -258,11 +263,7 @@ pub fn lights() -> (Scene, SceneInfo) {
         resolution: (960, 640),
         ..Scene::default()
     };
-    let info = SceneInfo {
-        camera_from_file: true,
-        lights: scene.lights.iter().map(|_| "light".to_string()).collect(),
-        ..SceneInfo::default()
-    };
+    let info = built_in_info(&scene);
     (scene, info)
 }
 
@@ -407,11 +408,7 @@ pub fn glass() -> (Scene, SceneInfo) {
         resolution: (960, 640),
         ..Scene::default()
     };
-    let info = SceneInfo {
-        camera_from_file: true,
-        lights: scene.lights.iter().map(|_| "light".to_string()).collect(),
-        ..SceneInfo::default()
-    };
+    let info = built_in_info(&scene);
     (scene, info)
 }
 
@@ -550,10 +547,6 @@ pub fn sheen() -> (Scene, SceneInfo) {
         resolution: (960, 720),
         ..Scene::default()
     };
-    let info = SceneInfo {
-        camera_from_file: true,
-        lights: scene.lights.iter().map(|_| "light".to_string()).collect(),
-        ..SceneInfo::default()
-    };
+    let info = built_in_info(&scene);
     (scene, info)
 }
